@@ -1,0 +1,17 @@
+"""The one place that states the compiler flags of SPEC section 5, for both targets."""
+
+# Shared by x86-64 (SIL, cffi) and the Cortex-M4F (PIL). Never -ffast-math, -Ofast, -march=native.
+COMMON = [
+    "-std=c99", "-pedantic", "-O2",
+    "-ffp-contract=off", "-fno-math-errno", "-fexcess-precision=standard",
+    "-Wall", "-Wextra", "-Wdouble-promotion", "-Wfloat-conversion", "-Werror",
+]
+
+ARM_CPU = ["-mcpu=cortex-m4", "-mthumb", "-mfpu=fpv4-sp-d16", "-mfloat-abi=hard"]
+
+ARM_CC = "arm-none-eabi-gcc"
+
+
+def with_opt(flags: list[str], opt: str) -> list[str]:
+    """The same flags with the optimisation level replaced (benchmarks at -O0/-Os/-O2)."""
+    return [opt if f.startswith("-O") else f for f in flags]

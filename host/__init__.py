@@ -1,0 +1,1 @@
+"""Ground-side float64 models: scenario, dynamics, guidance, simulator, controllers, CLI."""

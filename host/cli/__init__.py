@@ -1,0 +1,52 @@
+"""The `staregen` command: one subcommand module per stage, registered below.
+
+Each module in COMMANDS exposes `register(subparsers)`, which adds its parser and sets
+`func=handler(args) -> int`. User errors (bad input, bad files, missing toolchain) raise one
+of the layer error classes and are printed as one line with a non-zero exit, no traceback.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from codegen.errors import CodegenError
+from firmware.errors import FirmwareError
+from host.errors import HostError
+from tools.errors import ToolError
+
+USER_ERRORS = (HostError, CodegenError, FirmwareError, ToolError)
+
+# Subcommand modules, in the order `staregen --help` lists them.
+COMMANDS = [
+    "host.cli.simulate",
+    "host.cli.pipeline",
+]
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="staregen",
+        description="Staring-imaging attitude controllers: design on the ground, generate bit-exact flight C.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name in COMMANDS:
+        importlib.import_module(name).register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except USER_ERRORS as exc:
+        print(f"staregen {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"staregen {args.command}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Cycle model, setup and benchmark scripts."""

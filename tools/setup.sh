@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Idempotent set-up for a fresh Debian machine: the ARM toolchain from Debian, then the
+# Python package (torch pinned to the CPU wheel first so nothing pulls CUDA builds).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+
+if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 \
+   || ! [ -e /usr/lib/arm-none-eabi/newlib/thumb/v7e-m+fp/hard/libc.a ]; then
+  echo "setup: installing gcc-arm-none-eabi and libnewlib-arm-none-eabi (apt)"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq gcc-arm-none-eabi libnewlib-arm-none-eabi >/dev/null
+fi
+
+stamp=.setup-stamp
+want="$(sha256sum pyproject.toml | cut -d' ' -f1)"
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || ! python3 -c "import host, codegen, tools, firmware, torch" 2>/dev/null; then
+  echo "setup: pip install torch==2.13.0 and -e .[dev]"
+  python3 -m pip install -q --disable-pip-version-check "torch==2.13.0"
+  python3 -m pip install -q --disable-pip-version-check -e ".[dev]"
+  echo "$want" > "$stamp"
+fi
