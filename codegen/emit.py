@@ -1,0 +1,133 @@
+"""C emitter: artifact -> `<name>.h` / `<name>.c` (network path) plus the deterministic math library.
+
+Generation is a pure function of the artifact, the entry name and the generator version: no
+timestamps, no paths, no dict-order dependence, so the same artifact gives byte-identical sources.
+"""
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import jinja2
+import numpy as np
+
+from codegen import GENERATOR_VERSION
+from codegen.artifact import Artifact, hex_float
+from codegen.errors import CodegenError
+from tools import atomic
+
+TEMPLATES = Path(__file__).with_name("templates")
+CSRC = Path(__file__).with_name("csrc")
+MATH_FILES = ("sg_math.h", "sg_math.c")
+DEFAULT_NAME = "network"
+# Two neurons per iteration halve the loop overhead; four made GCC 12 spill an accumulator (arm -O2).
+UNROLL_CHOICES = (2, 1)
+
+
+def c_float(value) -> str:
+    """A float32 as a C hex-float literal that round-trips exactly, e.g. 0x1.99999ap-4f."""
+    v = np.float32(value)
+    if not np.isfinite(v):
+        raise CodegenError(f"cannot emit the non-finite constant {v} as a C literal")
+    return hex_float(float(v)) + "f"
+
+
+def check_name(name: str) -> str:
+    """Entry names become C identifiers and file names: lower-case, not the math library's prefix."""
+    if not re.fullmatch(r"[a-z][a-z0-9_]{0,30}", name) or name.startswith("sg_"):
+        raise CodegenError(
+            f"--name: {name!r} must be a lower-case C identifier (a-z, 0-9, _; at most 31 characters) "
+            "not starting with 'sg_'")
+    return name
+
+
+def _environment() -> jinja2.Environment:
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader(str(TEMPLATES)),
+        undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+        keep_trailing_newline=True, autoescape=False,
+    )
+
+
+def _labels(names, units, descriptions, lows=None, highs=None) -> list[dict]:
+    rows = []
+    for i, (n, u, d) in enumerate(zip(names, units, descriptions)):
+        row = {"index": i, "name": n, "unit": u, "description": d}
+        if lows is not None:
+            row.update(min=f"{float(lows[i]):.9g}", max=f"{float(highs[i]):.9g}")
+        rows.append(row)
+    return rows
+
+
+def _neurons(a: Artifact) -> list[dict]:
+    """Per hidden neuron, the constants in the order the MLP loop consumes them."""
+    return [
+        {"bias": c_float(a.b1[j]),
+         "w_in": [c_float(w) for w in a.W1[j]],
+         "w_out": [c_float(w) for w in a.W2[:, j]]}
+        for j in range(a.n_hidden)
+    ]
+
+
+def hidden_unroll(n_hidden: int) -> int:
+    """Neurons per MLP loop iteration: the largest of UNROLL_CHOICES dividing n_hidden (no remainder loop)."""
+    return next(u for u in UNROLL_CHOICES if n_hidden % u == 0)
+
+
+def template_context(a: Artifact, name: str) -> dict:
+    env, out = a.envelope, a.outputs
+    return {
+        "unroll": hidden_unroll(a.n_hidden), "stride": 1 + a.n_in + a.n_out,
+        "name": name, "P": name.upper(),
+        "n_in": a.n_in, "n_hidden": a.n_hidden, "n_out": a.n_out,
+        "sha256": a.sha256, "generator_version": GENERATOR_VERSION,
+        "creator": str(a.metadata.get("creator", "")),
+        "envelope_source": env.source,
+        "inputs": _labels(env.names, env.units, env.descriptions, env.min, env.max),
+        "outputs": _labels(out.names, out.units, out.descriptions),
+        "neurons": _neurons(a),
+        "b2": [c_float(v) for v in a.b2],
+        "in_xoffset": [c_float(v) for v in a.input_map.xoffset],
+        "in_gain": [c_float(v) for v in a.input_map.gain],
+        "in_ymin": c_float(a.input_map.ymin),
+        "out_xoffset": [c_float(v) for v in a.output_map.xoffset],
+        "out_gain": [c_float(v) for v in a.output_map.gain],
+        "out_ymin": c_float(a.output_map.ymin),
+    }
+
+
+def math_sources() -> dict[str, str]:
+    """The deterministic math library (codegen/csrc), copied verbatim next to the network."""
+    sources = {}
+    for fname in MATH_FILES:
+        path = CSRC / fname
+        if not path.is_file():
+            raise CodegenError(f"{path}: missing (the deterministic math library sg_math is not installed)")
+        sources[fname] = path.read_text(encoding="utf-8")
+    return sources
+
+
+def network_sources(a: Artifact, name: str = DEFAULT_NAME) -> dict[str, str]:
+    """{file name: text} of the generated network path and the math library it calls."""
+    check_name(name)
+    env, ctx = _environment(), template_context(a, name)
+    sources = {
+        f"{name}.h": env.get_template("network.h.j2").render(ctx),
+        f"{name}.c": env.get_template("network.c.j2").render(ctx),
+    }
+    sources.update(math_sources())
+    return sources
+
+
+def write_sources(sources: dict[str, str], out_dir: str | os.PathLike) -> list[Path]:
+    """Write each file atomically into out_dir (created if needed); other files there are left alone."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise CodegenError(f"--out: {out_dir} exists and is not a directory")
+    return [atomic.write_text(out_dir / fname, text) for fname, text in sorted(sources.items())]
+
+
+def emit(a: Artifact, out_dir: str | os.PathLike, name: str = DEFAULT_NAME) -> list[Path]:
+    """Generate and write `<name>.h`, `<name>.c`, `sg_math.h`, `sg_math.c` into out_dir."""
+    return write_sources(network_sources(a, name), out_dir)

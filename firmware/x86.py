@@ -1,0 +1,266 @@
+"""x86-64 build (SIL): generated C compiled with the flight flags, wrapped by cffi (out-of-line API mode).
+
+The flight sources are compiled by gcc with exactly firmware.flags.COMMON (+ -fPIC) into object
+files; cffi's own wrapper (compiled with Python's flags) only links them and adds batch loops that
+call the flight functions row by row. Builds land in a cache folder keyed by the sha256 of the
+sources, cdef, harness, flags, compiler version and Python ABI:
+    $STAREGEN_CACHE/x86/<hash>   (default ~/.cache/staregen/x86/<hash>)
+A build happens in a temporary sibling folder that is renamed into place, so concurrent builds
+of the same key are safe (the first rename wins; the loser's copy is discarded).
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib.machinery
+import importlib.util
+import json
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from types import ModuleType
+from typing import Mapping
+
+import numpy as np
+
+from firmware.errors import FirmwareError
+from firmware.flags import COMMON
+
+X86_CC = "gcc"
+X86_FLAGS = [*COMMON, "-fPIC"]
+# Bump when the layout of a cache folder changes.
+BUILD_LAYOUT = "1"
+
+_loaded: dict[str, "X86Build"] = {}
+
+
+@dataclass(frozen=True)
+class X86Build:
+    """A loaded build: the cffi ffi/lib, its cache folder and the flight object files."""
+
+    key: str
+    folder: Path
+    ffi: object
+    lib: object
+
+    @property
+    def objects(self) -> list[Path]:
+        return sorted((self.folder / "obj").glob("*.o"))
+
+    @property
+    def sources(self) -> Path:
+        return self.folder / "src"
+
+
+def cache_root() -> Path:
+    """$STAREGEN_CACHE, else ~/.cache/staregen."""
+    env = os.environ.get("STAREGEN_CACHE")
+    return Path(env).expanduser() if env else Path.home() / ".cache" / "staregen"
+
+
+def compiler_version(cc: str = X86_CC) -> str:
+    if shutil.which(cc) is None:
+        raise FirmwareError(f"x86 build: C compiler '{cc}' not found on PATH (install gcc)")
+    out = subprocess.run([cc, "--version"], capture_output=True, text=True, check=False)
+    return out.stdout.splitlines()[0] if out.stdout else cc
+
+
+def build_key(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC) -> str:
+    import cffi
+
+    h = hashlib.sha256()
+    parts = {
+        "layout": BUILD_LAYOUT, "flags": X86_FLAGS, "cc": compiler_version(cc),
+        "abi": sysconfig.get_config_var("EXT_SUFFIX"), "python": sys.version.split()[0],
+        "cffi": cffi.__version__, "cdef": cdef, "harness": harness,
+        "sources": sorted(sources.items()),
+    }
+    h.update(json.dumps(parts, sort_keys=True).encode("utf-8"))
+    return h.hexdigest()
+
+
+def _module_name(key: str) -> str:
+    return f"_sg_x86_{key[:24]}"
+
+
+def _one_line(text: str) -> str:
+    """The first compiler diagnostic (or the first non-empty line) of a build log."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    errors = [ln for ln in lines if "error" in ln]
+    return (errors or lines or ["(no compiler output)"])[0]
+
+
+def compile_objects(src_dir: Path, obj_dir: Path, cc: str = X86_CC) -> list[Path]:
+    """Compile every .c of src_dir with the flight flags; a failure raises FirmwareError (one line)."""
+    obj_dir.mkdir(parents=True, exist_ok=True)
+    objects = []
+    for c_file in sorted(src_dir.glob("*.c")):
+        obj = obj_dir / (c_file.stem + ".o")
+        cmd = [cc, *X86_FLAGS, "-I", str(src_dir), "-c", str(c_file), "-o", str(obj)]
+        try:
+            res = subprocess.run(cmd, capture_output=True, text=True, check=False)
+        except FileNotFoundError:
+            raise FirmwareError(f"x86 build: C compiler '{cc}' not found on PATH (install gcc)") from None
+        if res.returncode != 0:
+            raise FirmwareError(f"x86 build: {c_file.name} does not compile: {_one_line(res.stderr)}")
+        objects.append(obj)
+    return objects
+
+
+def _build_into(folder: Path, key: str, sources: Mapping[str, str], cdef: str, harness: str, cc: str) -> None:
+    import cffi
+
+    src = folder / "src"
+    src.mkdir(parents=True)
+    for fname, text in sources.items():
+        (src / fname).write_text(text, encoding="utf-8")
+    objects = compile_objects(src, folder / "obj", cc)
+    ffi = cffi.FFI()
+    ffi.cdef(cdef)
+    ffi.set_source(_module_name(key), harness, include_dirs=[str(src)],
+                   extra_objects=[str(o) for o in objects])
+    log = folder / "build.log"
+    try:
+        with open(log, "w") as fh, _redirect_fds(fh):
+            built = Path(ffi.compile(tmpdir=str(folder / "wrap"), verbose=False))
+    except Exception as exc:  # cffi raises VerificationError/CompileError/LinkError
+        raise FirmwareError(f"x86 build: cffi wrapper failed: {_one_line(str(exc) or log.read_text())}") from None
+    built.rename(folder / built.name)
+    manifest = {"key": key, "flags": X86_FLAGS, "cc": compiler_version(cc), "files": sorted(sources)}
+    (folder / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
+
+
+class _redirect_fds:
+    """Send the C compiler's stdout/stderr (file descriptors 1 and 2) to a log file while cffi builds."""
+
+    def __init__(self, fh):
+        self.fh = fh
+
+    def __enter__(self):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        self.saved = (os.dup(1), os.dup(2))
+        os.dup2(self.fh.fileno(), 1)
+        os.dup2(self.fh.fileno(), 2)
+
+    def __exit__(self, *exc):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(self.saved[0], 1)
+        os.dup2(self.saved[1], 2)
+        os.close(self.saved[0])
+        os.close(self.saved[1])
+        return False
+
+
+def _load(folder: Path, key: str) -> X86Build:
+    name = _module_name(key)
+    paths = list(folder.glob(name + "*" + sysconfig.get_config_var("EXT_SUFFIX")))
+    if len(paths) != 1:
+        raise FirmwareError(f"x86 build: cache folder {folder} is incomplete (delete it to rebuild)")
+    loader = importlib.machinery.ExtensionFileLoader(name, str(paths[0]))
+    spec = importlib.util.spec_from_file_location(name, str(paths[0]), loader=loader)
+    module: ModuleType = importlib.util.module_from_spec(spec)
+    loader.exec_module(module)
+    return X86Build(key=key, folder=folder, ffi=module.ffi, lib=module.lib)
+
+
+def build(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC) -> X86Build:
+    """Compile (or fetch from the cache) and load a cffi module of the given C sources.
+
+    sources: {file name: text} (headers and .c files, flight code); cdef: the declarations
+    exposed to Python; harness: extra C placed in the cffi wrapper (includes, batch loops).
+    """
+    key = build_key(sources, cdef, harness, cc)
+    if key in _loaded:
+        return _loaded[key]
+    parent = cache_root() / "x86"
+    folder = parent / key
+    if not folder.is_dir():
+        parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=parent))
+        try:
+            _build_into(tmp, key, sources, cdef, harness, cc)
+            try:
+                os.rename(tmp, folder)
+            except OSError:
+                if not folder.is_dir():  # a real failure, not a lost race
+                    raise
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    _loaded[key] = _load(folder, key)
+    return _loaded[key]
+
+
+# ----------------------------------------------------------------------------- the network path
+
+NETWORK_STAGES = ("normalise", "mlp", "denormalise", "eval")
+
+
+def network_cdef(name: str) -> str:
+    """The Python-visible API: the four flight functions and a batch loop for each."""
+    lines = []
+    for stage in NETWORK_STAGES:
+        lines.append(f"void {name}_{stage}(const float *in, float *out);")
+        lines.append(f"void {name}_{stage}_batch(const float *in, float *out, size_t n);")
+    return "\n".join(lines) + "\n"
+
+
+def network_harness(name: str) -> str:
+    """Batch loops over the flight functions; the arithmetic stays in the flight object."""
+    P = name.upper()
+    dims = {"normalise": (f"{P}_N_IN", f"{P}_N_IN"), "mlp": (f"{P}_N_IN", f"{P}_N_OUT"),
+            "denormalise": (f"{P}_N_OUT", f"{P}_N_OUT"), "eval": (f"{P}_N_IN", f"{P}_N_OUT")}
+    out = [f'#include <stddef.h>\n#include "{name}.h"\n']
+    for stage, (n_in, n_out) in dims.items():
+        out.append(
+            f"static void {name}_{stage}_batch(const float *in, float *out, size_t n)\n"
+            f"{{\n    size_t r;\n    for (r = 0; r < n; ++r) {{\n"
+            f"        {name}_{stage}(in + r * {n_in}, out + r * {n_out});\n    }}\n}}\n")
+    return "\n".join(out)
+
+
+class X86Network:
+    """The generated network path on x86, called on numpy batches (rows of float32)."""
+
+    def __init__(self, build_: X86Build, name: str, n_in: int, n_out: int):
+        self.build = build_
+        self.name = name
+        self.dims = {"normalise": (n_in, n_in), "mlp": (n_in, n_out),
+                     "denormalise": (n_out, n_out), "eval": (n_in, n_out)}
+
+    def _run(self, stage: str, x: np.ndarray) -> np.ndarray:
+        n_in, n_out = self.dims[stage]
+        x = np.ascontiguousarray(x)
+        if x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != n_in:
+            raise ValueError(f"x86 {stage}: expected float32 of shape (N, {n_in}), got {x.dtype} {x.shape}")
+        y = np.empty((x.shape[0], n_out), dtype=np.float32)
+        ffi = self.build.ffi
+        fn = getattr(self.build.lib, f"{self.name}_{stage}_batch")
+        fn(ffi.cast("const float *", ffi.from_buffer(x)), ffi.cast("float *", ffi.from_buffer(y)), x.shape[0])
+        return y
+
+    def normalise(self, x: np.ndarray) -> np.ndarray:
+        return self._run("normalise", x)
+
+    def mlp(self, xn: np.ndarray) -> np.ndarray:
+        return self._run("mlp", xn)
+
+    def denormalise(self, yn: np.ndarray) -> np.ndarray:
+        return self._run("denormalise", yn)
+
+    def eval(self, x: np.ndarray) -> np.ndarray:
+        return self._run("eval", x)
+
+
+def network_library(artifact, name: str = "network") -> X86Network:
+    """Generate the network C for an artifact, build it for x86 (cached) and load it."""
+    from codegen.emit import network_sources
+
+    sources = network_sources(artifact, name)
+    lib = build(sources, network_cdef(name), network_harness(name))
+    return X86Network(lib, name, artifact.n_in, artifact.n_out)

@@ -1,0 +1,34 @@
+"""`staregen artifact check FILE` and `staregen artifact random --shape 12-40-3 --seed S --out FILE`."""
+from __future__ import annotations
+
+import argparse
+
+from codegen import artifact as art
+
+
+def register(subparsers) -> None:
+    parser = subparsers.add_parser("artifact", help="check or create a model artifact (JSON)")
+    actions = parser.add_subparsers(dest="action", required=True, metavar="ACTION")
+
+    check = actions.add_parser("check", help="validate an artifact file and print its summary")
+    check.add_argument("file", metavar="FILE")
+    check.set_defaults(func=run_check)
+
+    random = actions.add_parser("random", help="write a randomly initialised (untrained) artifact")
+    random.add_argument("--shape", default="12-40-3", help="N_IN-N_HIDDEN-N_OUT (default 12-40-3)")
+    random.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    random.add_argument("--out", required=True, metavar="FILE", help="artifact to write")
+    random.set_defaults(func=run_random)
+
+
+def run_check(args: argparse.Namespace) -> int:
+    a = art.load(args.file)
+    print(f"OK {args.file}: {art.summary(a)}")
+    return 0
+
+
+def run_random(args: argparse.Namespace) -> int:
+    a = art.random_artifact(art.parse_shape(args.shape), args.seed)
+    path = a.save(args.out)
+    print(f"wrote {path}: {a.shape_text}, seed {args.seed}, sha256 {a.sha256}")
+    return 0
