@@ -21,6 +21,12 @@ USER_ERRORS = (HostError, CodegenError, FirmwareError, ToolError)
 COMMANDS = [
     "host.cli.simulate",
     "host.cli.pipeline",
+    "host.cli.samples",
+    "host.cli.artifact",
+    "host.cli.codegen",
+    "host.cli.c_eval",
+    "host.cli.verify",
+    "host.cli.cycles",
 ]
 
 

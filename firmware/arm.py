@@ -1,0 +1,256 @@
+"""STM32F417 build (PIL): generated C + adapter + startup + harness -> ELF, and its evaluation.
+
+Every C file is compiled with exactly firmware.flags.COMMON + ARM_CPU (the SPEC section 5 flags,
+optimisation level replaceable for benchmarks) plus -fstack-usage and per-function/data
+sections; the link uses stm32f417.ld, no start files, no C library unless an object needs one
+(then newlib-nano's libc, recorded in the build), libgcc, --gc-sections and a map file. After
+linking, `arm-none-eabi-nm` must show no libm function and no HAL symbol.
+
+Builds are cached like the x86 ones: $STAREGEN_CACHE/arm/<sha256 of inputs>.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import shutil
+import subprocess
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import jinja2
+import numpy as np
+
+from firmware.errors import FirmwareError
+from firmware.flags import ARM_CC, ARM_CPU, COMMON, with_opt
+
+HERE = Path(__file__).resolve().parent
+LINKER_SCRIPT = HERE / "stm32f417.ld"
+SUPPORT_FILES = ("startup.c", "harness.c", "harness.h")
+ADAPTERS = HERE / "adapters"
+BENCH = HERE / "bench"
+ARM_NM = "arm-none-eabi-nm"
+ARM_SIZE = "arm-none-eabi-size"
+EXTRA_CFLAGS = ["-fstack-usage", "-ffunction-sections", "-fdata-sections"]
+BUILD_LAYOUT = "1"
+
+# Names that would mean libm (or a vendor HAL) got linked in.
+_LIBM = re.compile(r"^(__ieee754_\w+|__kernel_\w+|(a?sin|a?cos|a?tan|atan2|sinh|cosh|tanh|exp|exp2|"
+                   r"expm1|log|log2|log10|log1p|pow|sqrt|cbrt|hypot|fmod|floor|ceil|round|"
+                   r"trunc|frexp|ldexp|modf|erf|erfc|lgamma|tgamma)[fl]?)$")
+_HAL = re.compile(r"^(HAL_|LL_|SystemInit$|SystemCoreClock)")
+
+
+@dataclass(frozen=True)
+class ArmBuild:
+    folder: Path
+    elf: Path
+    map: Path
+    newlib: bool   # True when newlib-nano's libc had to be linked (an object called memcpy etc.)
+
+    @property
+    def su_files(self) -> list[Path]:
+        return sorted((self.folder / "obj").glob("*.su"))
+
+
+def tool(name: str) -> str:
+    """Path of an ARM toolchain program; FirmwareError (one line) when it is missing."""
+    path = shutil.which(name)
+    if path is None:
+        raise FirmwareError(f"ARM toolchain: '{name}' not found on PATH "
+                            "(install gcc-arm-none-eabi and libnewlib-arm-none-eabi, see tools/setup.sh)")
+    return path
+
+
+def cflags(opt: str = "-O2", peer: bool = False) -> list[str]:
+    """The flight flags; a peer build (third-party C measured for comparison, e.g. emlearn)
+    keeps them all but -Werror, since its headers are not written for -Wextra -pedantic."""
+    flags = [*with_opt(COMMON, opt), *ARM_CPU, *EXTRA_CFLAGS]
+    return [f for f in flags if f != "-Werror"] if peer else flags
+
+
+def compiler_version() -> str:
+    out = subprocess.run([tool(ARM_CC), "--version"], capture_output=True, text=True, check=False)
+    return out.stdout.splitlines()[0] if out.stdout else ARM_CC
+
+
+def render_adapter(kind: str, **params) -> str:
+    """C text of firmware/adapters/<kind>.c.j2 (network: entry, header, n_in_macro, n_out_macro;
+    stateful: entry, header, state_t, input_t, output_t)."""
+    path = ADAPTERS / f"{kind}.c.j2"
+    if not path.is_file():
+        known = ", ".join(sorted(p.name[:-5] for p in ADAPTERS.glob("*.c.j2")))
+        raise FirmwareError(f"no harness adapter '{kind}' (known: {known})")
+    env = jinja2.Environment(undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+    try:
+        return env.from_string(path.read_text(encoding="utf-8")).render(**params)
+    except jinja2.UndefinedError as exc:
+        raise FirmwareError(f"adapter '{kind}': {exc}") from None
+
+
+def _one_line(text: str) -> str:
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    errors = [ln for ln in lines if "error" in ln or "undefined reference" in ln]
+    return (errors or lines or ["(no output)"])[0]
+
+
+def _run(cmd: Sequence[str], what: str) -> subprocess.CompletedProcess:
+    try:
+        return subprocess.run(list(cmd), capture_output=True, text=True, check=False)
+    except FileNotFoundError:
+        raise FirmwareError(f"ARM toolchain: '{cmd[0]}' not found ({what})") from None
+
+
+def _compile(src: Path, obj_dir: Path, opt: str, peer: bool) -> list[Path]:
+    cc = tool(ARM_CC)
+    objects = []
+    for c_file in sorted(src.glob("*.c")):
+        obj = obj_dir / (c_file.stem + ".o")
+        res = _run([cc, *cflags(opt, peer), "-I", str(src), "-c", str(c_file), "-o", str(obj)], "compile")
+        if res.returncode != 0:
+            raise FirmwareError(f"ARM build: {c_file.name} does not compile: {_one_line(res.stderr)}")
+        objects.append(obj)
+    return objects
+
+
+def _link(objects: list[Path], elf: Path, map_file: Path, libs: list[str]) -> subprocess.CompletedProcess:
+    cmd = [tool(ARM_CC), *ARM_CPU, "-nostartfiles", "-nostdlib", "-T", str(LINKER_SCRIPT),
+           "-Wl,--gc-sections", f"-Wl,-Map={map_file}", "-o", str(elf), *map(str, objects), *libs]
+    return _run(cmd, "link")
+
+
+def link(objects: list[Path], elf: Path, map_file: Path) -> bool:
+    """Link without any C library; only if that leaves undefined references, add newlib-nano's
+    libc. Returns whether newlib was needed."""
+    res = _link(objects, elf, map_file, ["-lgcc"])
+    if res.returncode == 0:
+        return False
+    if "undefined reference" in res.stderr:
+        res = _link(objects, elf, map_file, ["-lc_nano", "-lgcc"])
+        if res.returncode == 0:
+            return True
+    raise FirmwareError(f"ARM build: link failed: {_one_line(res.stderr)}")
+
+
+def check_symbols(elf: Path, allow_libm: bool = False) -> None:
+    """No libm function (unless allowed) and no HAL symbol in the image (arm-none-eabi-nm)."""
+    res = _run([tool(ARM_NM), "--defined-only", str(elf)], "nm")
+    if res.returncode != 0:
+        raise FirmwareError(f"ARM build: nm failed on {elf.name}: {_one_line(res.stderr)}")
+    names = [ln.split()[-1] for ln in res.stdout.splitlines() if ln.strip()]
+    bad = sorted({n for n in names if (_LIBM.match(n) and not allow_libm) or _HAL.match(n)})
+    if bad:
+        raise FirmwareError(f"ARM build: forbidden library symbols linked: {', '.join(bad[:5])}")
+
+
+def _build_into(folder: Path, files: Mapping[str, str], opt: str, peer: bool) -> bool:
+    src, obj = folder / "src", folder / "obj"
+    src.mkdir(parents=True)
+    obj.mkdir()
+    for fname, text in files.items():
+        (src / fname).write_text(text, encoding="utf-8")
+    objects = _compile(src, obj, opt, peer)
+    if peer:  # third-party C calls libm (tanhf, expf) and newlib
+        res = _link(objects, folder / "firmware.elf", folder / "firmware.map", ["-lm", "-lc_nano", "-lgcc"])
+        if res.returncode != 0:
+            raise FirmwareError(f"ARM build: link failed: {_one_line(res.stderr)}")
+        newlib = True
+    else:
+        newlib = link(objects, folder / "firmware.elf", folder / "firmware.map")
+    check_symbols(folder / "firmware.elf", allow_libm=peer)
+    manifest = {"flags": cflags(opt, peer), "cc": compiler_version(), "newlib": newlib, "peer": peer,
+                "files": sorted(files)}
+    (folder / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
+    return newlib
+
+
+def _cache_root() -> Path:
+    env = os.environ.get("STAREGEN_CACHE")
+    return (Path(env).expanduser() if env else Path.home() / ".cache" / "staregen") / "arm"
+
+
+def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool = False) -> ArmBuild:
+    """Build (or fetch from the cache) the ELF of generated sources + an adapter's C text.
+
+    peer=True is for benchmarks of third-party C only: libm and newlib are linked and
+    warnings are not errors (see cflags)."""
+    files = dict(sources)
+    files["adapter.c"] = adapter
+    for fname in SUPPORT_FILES:
+        files[fname] = (HERE / fname).read_text(encoding="utf-8")
+    key_parts = {"layout": BUILD_LAYOUT, "flags": cflags(opt, peer), "peer": peer, "cc": compiler_version(),
+                 "ld": LINKER_SCRIPT.read_text(), "files": sorted(files.items())}
+    key = hashlib.sha256(json.dumps(key_parts, sort_keys=True).encode()).hexdigest()
+    folder = _cache_root() / key
+    if not (folder / "manifest.json").is_file():
+        folder.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=folder.parent))
+        try:
+            _build_into(tmp, files, opt, peer)
+            try:
+                os.rename(tmp, folder)
+            except OSError:
+                if not (folder / "manifest.json").is_file():
+                    raise
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    newlib = json.loads((folder / "manifest.json").read_text())["newlib"]
+    return ArmBuild(folder, folder / "firmware.elf", folder / "firmware.map", newlib)
+
+
+def network_build(artifact, name: str = "network", opt: str = "-O2") -> ArmBuild:
+    """The generated network path of an artifact with the network adapter."""
+    from codegen.emit import network_sources
+
+    P = name.upper()
+    adapter = render_adapter("network", entry=name, header=f"{name}.h",
+                             n_in_macro=f"{P}_N_IN", n_out_macro=f"{P}_N_OUT")
+    return build(network_sources(artifact, name), adapter, opt)
+
+
+def bench_build(out_dir: Path) -> Path:
+    """Assemble the micro-benchmarks (firmware/bench/*.S) into one ELF in out_dir."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    elf = out_dir / "bench.elf"
+    sources = sorted(str(p) for p in BENCH.glob("*.S"))
+    cmd = [tool(ARM_CC), *ARM_CPU, "-I", str(BENCH), "-nostartfiles", "-nostdlib",
+           "-T", str(LINKER_SCRIPT), "-Wl,-e,0", "-o", str(elf), *sources]
+    res = _run(cmd, "assemble")
+    if res.returncode != 0:
+        raise FirmwareError(f"bench build failed: {_one_line(res.stderr)}")
+    return elf
+
+
+class ArmNetwork:
+    """A network ELF run in the emulator through the harness (records = float32 rows)."""
+
+    def __init__(self, elf: str | os.PathLike):
+        from tools.m4.harness import Harness
+
+        self.harness = Harness(elf)
+        self.n_in = self.harness.in_bytes // 4
+        self.n_out = self.harness.out_bytes // 4
+
+    def eval(self, x: np.ndarray) -> np.ndarray:
+        x = np.ascontiguousarray(x)
+        if x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != self.n_in:
+            raise ValueError(f"arm eval: expected float32 of shape (N, {self.n_in}), got {x.dtype} {x.shape}")
+        out = self.harness.run(x.view(np.uint8).reshape(x.shape[0], -1))
+        return out.view(np.float32).reshape(x.shape[0], self.n_out)
+
+
+def network_arm(artifact, name: str = "network") -> ArmNetwork:
+    return ArmNetwork(network_build(artifact, name).elf)
+
+
+def eval_network_arm(artifact_or_elf, x: np.ndarray, name: str = "network") -> np.ndarray:
+    """(N, n_in) float32 -> (N, n_out) float32 through the ARM build in the emulator.
+
+    artifact_or_elf: a codegen Artifact (generated, built, cached) or the path of a built ELF.
+    """
+    if isinstance(artifact_or_elf, (str, os.PathLike)):
+        return ArmNetwork(artifact_or_elf).eval(x)
+    return network_arm(artifact_or_elf, name).eval(x)

@@ -1,0 +1,36 @@
+#include "common.inc"
+
+@ bench: bench_it_blocks
+@ expect: 20
+@ Instructions skipped inside an IT block cost 1 (Unicorn runs no hook for them).
+@   movs r1, #0 ; cmp r1, #0              2 x 1                      = 2
+@   ite eq                                1                          = 1
+@   moveq r2, #1 (runs) ; movne r2, #2 (skipped)  1 + 1              = 2
+@   itt ne                                1                          = 1
+@   ldrne r3, [r0] ; ldrne r3, [r0, #4]   both skipped: 1 + 1        = 2
+@   ite eq                                1                          = 1
+@   ldreq r3, [r0] (runs: LDR 2) ; addne r3, r3, #1 (skipped: 1)     = 3
+@   cmp r1, #1 ; it eq                    2 x 1                      = 2
+@   bxeq lr (skipped: not taken)          1                          = 1
+@   cmp r1, #0 ; it eq                    2 x 1                      = 2
+@   bxeq lr (runs: taken, 1 + P)          3                          = 3
+BENCH bench_it_blocks
+  movs r1, #0
+  cmp r1, #0
+  ite eq
+  moveq r2, #1
+  movne r2, #2
+  itt ne
+  ldrne r3, [r0]
+  ldrne r3, [r0, #4]
+  ite eq
+  ldreq r3, [r0]
+  addne r3, r3, #1
+  cmp r1, #1
+  it eq
+  bxeq lr
+  cmp r1, #0
+  it eq
+  bxeq lr
+  bkpt #2
+END bench_it_blocks
