@@ -121,3 +121,26 @@ def test_several_targets_write_averages(tmp_path, capsys, monkeypatch):
     assert doc["J_w"] == pytest.approx(np.mean([t["J_w"] for t in doc["targets"]]))
     assert np.load(tmp_path / "histories.npz")["A_bd"].shape == (2, 111, 3)
     assert (tmp_path / "targets_JA_Jw.png").exists()
+
+
+def test_simulate_tanh_writes_the_issue7_metrics(tmp_path):
+    import json
+
+    from host.cli import main as cli_main
+
+    out = tmp_path / "tanh"
+    assert cli_main(["simulate", "--controller", "tanh", "--period", "0.1", "--duration", "3", "--out", str(out)]) == 0
+    m = json.loads((out / "metrics.json").read_text())
+    for key in ("t_settle", "e_final", "we_final", "u_max"):
+        assert key in m
+    assert 0 < m["u_max"] <= 4.5  # the tanh law bounds |u_i| by k1 + k2 + k3 = 4.5 N*m
+    assert sorted(p.name for p in out.glob("fig*.png")) == [
+        "fig5_attitude_error.png", "fig6_angular_velocity_error.png", "fig7_x2.png", "fig8_torque.png"]
+
+
+def test_period_is_refused_for_the_staring_controllers(tmp_path, capsys):
+    from host.cli import main as cli_main
+
+    assert cli_main(["simulate", "--controller", "pid", "--period", "0.1", "--out", str(tmp_path / "o")]) == 2
+    assert "--period" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

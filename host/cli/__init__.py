@@ -49,6 +49,10 @@ def main(argv: list[str] | None = None) -> int:
     except USER_ERRORS as exc:
         print(f"staregen {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:
+        # e.g. `staregen ... | head`: the reader went away; not an error of ours
+        sys.stderr.close()
+        return 0
     except KeyboardInterrupt:
         print(f"staregen {args.command}: interrupted", file=sys.stderr)
         return 130

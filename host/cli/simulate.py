@@ -24,7 +24,12 @@ DEFAULT_DURATION_S = 100.0
 def register(subparsers) -> None:
     p = subparsers.add_parser("simulate", help="closed-loop staring simulation and J_A, J_w, J metrics",
                               description=__doc__.splitlines()[0])
-    p.add_argument("--controller", default="pid", help=f"controller ({', '.join(sorted(CONTROLLERS))}; default pid)")
+    p.add_argument("--controller", default="pid",
+                   help=f"controller ({', '.join(sorted(CONTROLLERS))}, or 'tanh' for the paper-000 "
+                        "finite-time example; default pid)")
+    p.add_argument("--period", default=None,
+                   help="tanh only: control period in s (zero-order hold); omitted = continuous reference")
+    p.add_argument("--dt", default=None, help="tanh only: plant RK4 step in s (default 5e-4)")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
     p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
@@ -87,7 +92,35 @@ def build_plan(args) -> ImagingPlan:
                        t_first=parse_number(args.settle, "--settle", non_negative=True))
 
 
+def run_tanh_example(args: argparse.Namespace) -> int:
+    """The paper-000 example (section 4.2) flown by the tanh saturation law; metrics.json + Figs. 5-8."""
+    from host import tanh_example  # the staring scenario does not need it
+
+    duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else "40",
+                            "--duration", positive=True)
+    period = None if args.period is None else parse_number(args.period, "--period", positive=True)
+    dt = parse_number(args.dt or str(tanh_example.MAX_REFERENCE_STEP), "--dt", positive=True)
+    out = Path(args.out)
+    check_output_folder(out)
+    try:
+        with atomic.directory(out) as tmp:
+            result = tanh_example.run(period, duration, dt, out_dir=tmp)
+    except OSError as exc:
+        raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
+    m = result["metrics"]
+    mode = "continuous (RK4 %g s)" % dt if period is None else "sampled every %g s" % period
+    print(f"tanh law, paper-000 example, {mode}, {duration:g} s")
+    for key, unit in (("t_settle", "s"), ("e_final", ""), ("we_final", "rad/s"), ("u_max", "N*m")):
+        print(f"  {key:9s} {m[key]!s:>14} {unit}")
+    print(f"wrote {out}/metrics.json")
+    return 0
+
+
 def main(args: argparse.Namespace) -> int:
+    if args.controller == "tanh":
+        return run_tanh_example(args)
+    if args.period is not None or args.dt is not None:
+        raise HostError("--period and --dt apply to --controller tanh only")
     targets = parse_target(args.target)
     config, plan = build_config(args), build_plan(args)
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
