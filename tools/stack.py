@@ -69,8 +69,8 @@ def call_graph(image: Image) -> tuple[dict[str, set[str]], dict[str, list[str]]]
         if not FLASH[0] <= f.start < FLASH[0] + FLASH[1] or f.size == 0:
             continue
         callees = graph.setdefault(f.name, set())
-        code = image.read(f.start, f.size)
-        for insn in cs.disasm(code, f.start):
+        for insn in (i for addr, size in image.code_ranges(f.start, f.size)
+                     for i in cs.disasm(image.read(addr, size), addr)):
             target = _branch_target(insn)
             if insn.id == A.ARM_INS_BLX and target is None:
                 indirect.setdefault(f.name, []).append(f"0x{insn.address:08x}")

@@ -1,9 +1,11 @@
 """`staregen pipeline`: the whole flow on the default preset, as a sequence of stage functions.
 
-For now: scenario summary, then the central-target PID simulation (metrics printed, artifacts in
-<out>/pid_central/), then a short report. Later issues insert their stages (sample creation,
-training, codegen, SIL/PIL) into STAGES. The output folder is built atomically: a failed stage
-leaves no partial folder.
+Stages: scenario summary; the central-target PID simulation (<out>/pid_central/); the network
+artifact (<out>/network.json: a stand-in fitted to the PID law until sample creation and training
+join the pipeline); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
+ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); a
+report (report.json, report.txt). The output folder is built atomically: a failed stage leaves
+no partial folder.
 """
 from __future__ import annotations
 
@@ -32,6 +34,7 @@ PRESET_SEED = 0
 class PipelineContext:
     out: Path                                     # the temporary folder being built
     results: dict = field(default_factory=dict)   # stage name -> summary (goes into report.json)
+    artifact: object = None                       # the network artifact (codegen.artifact.Artifact)
     report: list[str] = field(default_factory=list)
 
 
@@ -62,12 +65,69 @@ def stage_pid_central(ctx: PipelineContext) -> None:
     ctx.report.append(format_table(result))
 
 
+GATE_VECTORS = 100_000
+GATE_SEED = 0
+CYCLES_PER_CLASS = 100
+
+
+def stage_network(ctx: PipelineContext) -> None:
+    """The network artifact the flight C is generated from (stand-in: fitted to the PID law)."""
+    from host.standin import fit_pid_standin
+
+    a = fit_pid_standin(seed=PRESET_SEED)
+    a.save(ctx.out / "network.json")
+    ctx.artifact = a
+    ctx.results["network"] = {"artifact": "network.json", "shape": a.shape_text, "sha256": a.sha256,
+                              "kind": "stand-in fitted to the Table 1 PID law"}
+    ctx.report.append(f"network: {a.shape_text} stand-in (fitted to the PID law), sha256 {a.sha256[:16]}…")
+
+
+def stage_codegen(ctx: PipelineContext) -> None:
+    """Flight C of the network path into <out>/c (network.h/.c, sg_math.h/.c)."""
+    from codegen import emit
+
+    files = emit.emit(ctx.artifact, ctx.out / "c", name="network")
+    ctx.results["codegen"] = {"folder": "c", "files": sorted(Path(f).name for f in files)}
+    ctx.report.append("codegen: " + ", ".join(sorted(Path(f).name for f in files)) + " in c/")
+
+
+def stage_gate(ctx: PipelineContext) -> None:
+    """golden == x86 C == ARM C, bit for bit, on the gate's vector set (SPEC section 6)."""
+    from host.cli.verify import gate_targets, run_gate
+
+    t0 = time.perf_counter()
+    ok = run_gate(ctx.artifact, GATE_VECTORS, GATE_SEED, gate_targets("all"))
+    ctx.results["gate"] = {"vectors": GATE_VECTORS, "targets": ["golden", *gate_targets("all")], "pass": ok,
+                           "time_s": round(time.perf_counter() - t0, 2)}
+    if not ok:
+        raise HostError("bit-exact gate failed: golden, x86 and ARM outputs differ (see above)")
+    ctx.report.append(f"gate: golden == x86 == ARM on {GATE_VECTORS} vectors "
+                      f"({ctx.results['gate']['time_s']} s)")
+
+
+def stage_cycles(ctx: PipelineContext) -> None:
+    """Cortex-M4 cycles, flash, RAM and stack of the network path (cycle model, all modes)."""
+    from host.cli.cycles import MODES, network_report, text_report
+
+    entry, facts = network_report(ctx.artifact, "network", MODES, CYCLES_PER_CLASS, GATE_SEED)
+    lines = text_report("network", entry, facts, MODES)
+    atomic.write_json(ctx.out / "cycles.json", {"entries": {"network": entry}})
+    atomic.write_text(ctx.out / "cycles.md", "# Cycle report (pipeline)\n\n" + "\n".join(lines) + "\n")
+    worst = {m: entry["cycles"][m]["max"] for m in MODES}
+    ctx.results["cycles"] = {"network_max": worst, "flash_bytes": entry["flash_bytes"],
+                             "ram_bytes": entry["ram_bytes"], "stack_bytes": entry["stack_bytes"]}
+    ctx.report.append("cycles (network path, worst case): " + ", ".join(f"{m} {c}" for m, c in worst.items())
+                      + f"; flash {entry['flash_bytes']} B, RAM {entry['ram_bytes']} B, stack {entry['stack_bytes']} B"
+                      + f" (paper: 3.3 ms = 554,400 cycles)")
+
+
 def stage_report(ctx: PipelineContext) -> None:
     atomic.write_json(ctx.out / "report.json", ctx.results)
     atomic.write_text(ctx.out / "report.txt", "\n\n".join(ctx.report) + "\n")
 
 
-STAGES = [stage_scenario, stage_pid_central, stage_report]
+STAGES = [stage_scenario, stage_pid_central, stage_network, stage_codegen, stage_gate, stage_cycles,
+          stage_report]
 
 
 def register(subparsers) -> None:

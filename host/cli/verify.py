@@ -63,20 +63,25 @@ def compare_target(target: str, a: art.Artifact, x: np.ndarray, y_golden: np.nda
     return result.ok
 
 
-def run(args: argparse.Namespace) -> int:
-    if args.vectors < 1:
-        raise HostError(f"--vectors: need at least 1, got {args.vectors}")
+def run_gate(a: art.Artifact, n_vectors: int, seed: int, targets: list[str]) -> bool:
+    """Golden vs each target on the gate's vector set; prints the report, returns pass/fail."""
     start = time.perf_counter()
-    a = art.load(args.artifact)
-    vs = vectors.gate_vectors(a.envelope, args.vectors, args.seed)
+    vs = vectors.gate_vectors(a.envelope, n_vectors, seed)
     counts = ", ".join(f"{k} {v}" for k, v in vs.counts().items())
-    print(f"artifact {args.artifact}: {a.shape_text}, sha256 {a.sha256}")
-    print(f"vectors: {vs.x.shape[0]} ({counts}), seed {args.seed}")
+    print(f"vectors: {vs.x.shape[0]} ({counts}), seed {seed}")
     t0 = time.perf_counter()
     y_golden = golden.network_eval(a, vs.x)
     print(f"golden: evaluate {time.perf_counter() - t0:.2f} s")
-    ok = all([compare_target(t, a, vs.x, y_golden) for t in gate_targets(args.target)])
+    ok = all([compare_target(t, a, vs.x, y_golden) for t in targets])
     for line in reference_error(a, vs, y_golden):
         print(line)
     print(f"total {time.perf_counter() - start:.2f} s: {'PASS' if ok else 'FAIL'}")
-    return 0 if ok else 1
+    return ok
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.vectors < 1:
+        raise HostError(f"--vectors: need at least 1, got {args.vectors}")
+    a = art.load(args.artifact)
+    print(f"artifact {args.artifact}: {a.shape_text}, sha256 {a.sha256}")
+    return 0 if run_gate(a, args.vectors, args.seed, gate_targets(args.target)) else 1

@@ -40,6 +40,7 @@ class Image:
                 self.segments = [Segment(s["p_paddr"], s.data()) for s in elf.iter_segments()
                                  if s["p_type"] == "PT_LOAD" and s["p_filesz"] > 0]
                 self.symbols, funcs = _read_symbols(elf)
+                self.mapping = _read_mapping_symbols(elf)
                 self.sections = {s.name: (s["sh_addr"], s["sh_size"], s["sh_flags"], s["sh_type"])
                                  for s in elf.iter_sections() if s.name}
         except OSError as exc:
@@ -80,6 +81,23 @@ class Image:
                 return seg.data[off:off + size]
         raise ToolError(f"{self.path.name}: address 0x{addr:08x} is not in a loaded segment")
 
+    def code_ranges(self, start: int, size: int) -> list[tuple[int, int]]:
+        """The (addr, size) pieces of [start, start+size) that hold instructions, not data.
+
+        ARM ELF mapping symbols mark where code ($t, Thumb) and data ($d: literal pools, jump
+        tables) begin; decoding a literal pool as Thumb gives invented branches.
+        """
+        end = start + size
+        marks = [(a, k) for a, k in self.mapping if start < a < end]
+        before = [k for a, k in self.mapping if a <= start]
+        kind = before[-1] if before else "t"
+        pieces, cursor = [], start
+        for addr, k in marks + [(end, None)]:
+            if kind == "t" and addr > cursor:
+                pieces.append((cursor, addr - cursor))
+            cursor, kind = addr, k
+        return pieces
+
     def word(self, name: str) -> int:
         """A 32-bit constant stored in the image (e.g. adapter_in_bytes)."""
         return struct.unpack("<I", self.read(self.symbol(name), 4))[0]
@@ -104,3 +122,13 @@ def _read_symbols(elf) -> tuple[dict[str, int], list[Function]]:
                 funcs[value] = Function(s.name, value, s["st_size"])
         symbols.setdefault(s.name, value)
     return symbols, list(funcs.values())
+
+
+def _read_mapping_symbols(elf) -> list[tuple[int, str]]:
+    """Sorted (address, 't' | 'd' | 'a') from the ARM mapping symbols $t, $d, $a (and $t.N, ...)."""
+    marks = []
+    for s in elf.get_section_by_name(".symtab").iter_symbols():
+        name = s.name
+        if name[:2] in ("$t", "$d", "$a") and (len(name) == 2 or name[2] == "."):
+            marks.append((s["st_value"] & ~1, name[1]))
+    return sorted(set(marks))
