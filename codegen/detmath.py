@@ -1,0 +1,317 @@
+"""numpy float32 twin of codegen/csrc/sg_math.c, operation for operation, bit for bit.
+
+Each function mirrors its C counterpart: the same IEEE single-precision operations in the same
+order (numpy float32 ufuncs round each operation once, like SSE and FPv4-SP without FMA), the
+C branches as masks (np.where keeps every lane's arithmetic identical to the branch it takes),
+and bit reinterpretation through .view(np.uint32) like the C union. Inputs are float32 arrays or
+scalars (converted with np.asarray(..., np.float32)); outputs are float32 arrays of the same
+shape. Never np.tanh/np.exp/np.log/np.sin/...: their SIMD versions differ from any C code.
+
+Warnings are silenced inside each function: lanes whose result is discarded by np.where (or
+the IEEE special values themselves) legitimately produce inf/nan intermediates.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+F32 = np.float32
+U32 = np.uint32
+
+#: sin/cos are accurate (docs/math.md) for |x| <= TRIG_MAX_ARG; beyond it finite in [-1, 1].
+TRIG_MAX_ARG = F32(8192.0)
+
+#: Published maximum error in ulp (measured ones in docs/math.md are below); the tests assert them.
+ULP_BOUND = {"tanhf": 2.0, "expf": 2.0, "logf": 2.0, "sinf": 2.0, "cosf": 2.0,
+             "asinf": 2.0, "atan2f": 3.0, "sqrtf": 0.5}
+
+#: powf_pos(x, y) = expf(y * logf(x)): error <= POW_ULP_BASE + POW_ULP_PER_LOG * |y ln x| ulp
+#: (the relative error of y*ln x, <= 1.34 * 2^-23, becomes an absolute error in the exponent).
+POW_ULP_BASE = 1.5
+POW_ULP_PER_LOG = 2.7
+
+
+def _f32(x) -> np.ndarray:
+    return np.asarray(x, dtype=F32)
+
+
+def _as_u32(x: np.ndarray) -> np.ndarray:
+    return np.asarray(x, dtype=F32).view(U32)  # same item size: works for 0-d and strided
+
+
+def _as_f32(u: np.ndarray) -> np.ndarray:
+    return np.asarray(u, dtype=U32).view(F32)
+
+
+def _check(y: np.ndarray) -> np.ndarray:
+    assert y.dtype == F32, y.dtype
+    return y
+
+
+def _horner(r: np.ndarray, coeffs: tuple[float, ...]) -> np.ndarray:
+    """p = c[0]; p = p*r + c[i] ... in float32, the C's fixed Horner order."""
+    p = np.full_like(r, F32(coeffs[0]))
+    for c in coeffs[1:]:
+        p = p * r + F32(c)
+    return p
+
+
+# ---------------------------------------------------------------- tanh
+
+CSRC = Path(__file__).resolve().parent / "csrc"
+_TANH_M = 3
+_TANH_FIRST = (127 - 12) << _TANH_M
+_TANH_TINY_BITS = 0x39800000  # 2^-12
+
+
+def _load_tanh_table() -> np.ndarray:
+    """sg_tanh_tab, read from sg_math.c itself so that C and twin cannot drift apart."""
+    text = (CSRC / "sg_math.c").read_text()
+    body = text[text.index("BEGIN sg_tanh_tab"):text.index("END sg_tanh_tab")]
+    rows = re.findall(r"\{([^}]*)\}", body)
+    tab = np.array([[float.fromhex(v.strip().rstrip("f")) for v in r.split(",")] for r in rows])
+    assert tab.shape == (121, 6), tab.shape
+    out = tab.astype(F32)
+    assert np.array_equal(out.astype(np.float64), tab), "table entries must be float32 values"
+    return out
+
+
+_TANH_TAB = _load_tanh_table()
+_TANH_COLS = tuple(np.ascontiguousarray(_TANH_TAB[:, j]) for j in range(6))  # fast 1-D take
+
+
+def tanhf(x) -> np.ndarray:
+    """Mirror of sg_tanhf: interval table indexed by exponent + 3 mantissa bits, degree-4
+    polynomial in |x| - c; x itself below 2^-12, +-1 from 9 on, NaN passes."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        ux = _as_u32(x)
+        i = ((ux << U32(1)) >> U32(24 - _TANH_M)) - U32(_TANH_FIRST)
+        inside = i < U32(len(_TANH_TAB))
+        idx = np.where(inside, i, U32(0)).astype(np.intp)
+        t = np.abs(x) - _TANH_COLS[0].take(idx)
+        p = _TANH_COLS[5].take(idx)
+        for j in (4, 3, 2, 1):
+            p = p * t + _TANH_COLS[j].take(idx)
+        neg = (ux >> U32(31)) != U32(0)
+        y = np.where(neg, -p, p)
+        sat = np.where(neg, F32(-1.0), F32(1.0))
+        tiny = (ux << U32(1)) < U32((_TANH_TINY_BITS << 1) & 0xFFFFFFFF)
+        out = np.where(tiny, x, np.where(np.isnan(x), x + x, sat))
+        y = np.where(inside, y, out)
+    return _check(y)
+
+
+# ---------------------------------------------------------------- exp
+
+_MAGIC = F32(float.fromhex("0x1.8p+23"))
+_INV_LN2 = F32(float.fromhex("0x1.715476p+0"))
+_LN2_HI = F32(float.fromhex("0x1.62e4p-1"))
+_LN2_LO = F32(float.fromhex("0x1.7f7d1cp-20"))
+EXP_OVF = F32(float.fromhex("0x1.62e42ep+6"))
+EXP_UNF = F32(float.fromhex("-0x1.9fe368p+6"))
+_EXP_P = tuple(float.fromhex(h) for h in ("0x1.6c5a98p-10", "0x1.12243ap-7", "0x1.5555b6p-5",
+                                           "0x1.5554b6p-3", "0x1p-1", "0x1p+0"))
+_INF = F32(np.inf)
+_NAN = F32(np.nan)
+
+
+def _pow2(u: np.ndarray, bias: int) -> np.ndarray:
+    """sg_pow2: 2^(k + bias) from the bits u of k + MAGIC (uint32 wrap-around as in C)."""
+    return _as_f32((u + U32(bias & 0xFFFFFFFF) + U32(127)) << U32(23))
+
+
+def expf(x) -> np.ndarray:
+    """Mirror of sg_expf: Cody-Waite ln2 reduction, degree-6 polynomial, s + s*q scaling."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        inside = (x <= EXP_OVF) & (x >= EXP_UNF)
+        xi = np.where(inside, x, F32(0.0))
+        t = xi * _INV_LN2 + _MAGIC
+        kf = t - _MAGIC
+        r = (xi - kf * _LN2_HI) - kf * _LN2_LO
+        q = _horner(r, _EXP_P) * r
+        u = _as_u32(t)
+        s0, s1, s2 = _pow2(u, 0), _pow2(u, -1), _pow2(u, 64)
+        y = np.where((kf >= F32(-126.0)) & (kf <= F32(127.0)), s0 + s0 * q,
+                     np.where(kf > F32(0.0), (s1 + s1 * q) * F32(2.0),
+                              (s2 + s2 * q) * F32(2.0**-64)))
+        special = np.where(np.isnan(x), x + x, np.where(x > F32(0.0), _INF, F32(0.0)))
+        y = np.where(inside, y, special)
+    return _check(y)
+
+
+# ---------------------------------------------------------------- log
+
+_LOG_R = tuple(float.fromhex(h) for h in ("0x1.2f29fep-2", "0x1.997aa8p-2", "0x1.55555cp-1"))
+
+
+def logf(x) -> np.ndarray:
+    """Mirror of sg_logf: m in [sqrt(1/2), sqrt 2), s = f/(2+f), fdlibm's summation order."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        ix = _as_u32(x)
+        rare = (ix < U32(0x00800000)) | (ix >= U32(0x7F800000))
+        zero = (ix << U32(1)) == U32(0)
+        sub = (ix < U32(0x00800000)) & ~zero
+        ix = np.where(sub, _as_u32(x * F32(2.0**23)), ix)
+        kbias = np.where(sub, F32(-23.0), F32(0.0))
+        ix = ix + U32(0x3F800000 - 0x3F3504F3)
+        kf = ((ix >> U32(23)).astype(np.int32) - np.int32(127)).astype(F32) + kbias
+        f = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F3504F3)) - F32(1.0)
+        s = f / (F32(2.0) + f)
+        z = s * s
+        rz = _horner(z, _LOG_R) * z
+        hfsq = F32(0.5) * f * f
+        y = (((s * (hfsq + rz) + kf * _LN2_LO) - hfsq) + f) + kf * _LN2_HI
+        special = np.where(zero, -_INF,
+                           np.where(np.isnan(x) | (x == _INF), x + x,
+                                    np.where(x < F32(0.0), _NAN, y)))
+        y = np.where(rare, special, y)
+    return _check(y)
+
+
+# ---------------------------------------------------------------- sin, cos
+
+_TWO_OVER_PI = F32(float.fromhex("0x1.45f306p-1"))
+_PIO2_PARTS = tuple(F32(float.fromhex(h)) for h in
+                    ("0x1.92p+0", "0x1.fb4p-12", "0x1.444p-24", "0x1.68c234p-39"))
+_PIO4 = F32(float.fromhex("0x1.921fb6p-1"))
+_SIN_P = tuple(float.fromhex(h) for h in ("-0x1.9952ecp-13", "0x1.110776p-7", "-0x1.555546p-3"))
+_COS_P = tuple(float.fromhex(h) for h in ("0x1.9b8a82p-16", "-0x1.6c123cp-10", "0x1.555554p-5"))
+
+
+def _trig_reduce(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The reduction part of sg_trig: (rhi, rlo, j mod 4)."""
+    p1, p2, p3, p4 = _PIO2_PARTS
+    t = x * _TWO_OVER_PI + _MAGIC
+    jf = t - _MAGIC
+    t2 = (x - jf * p1) - jf * p2
+    w = jf * p3
+    hi = t2 - w
+    lo = ((t2 - hi) - w) - jf * p4
+    outside = ~(np.abs(x) <= TRIG_MAX_ARG)
+    clamped = np.where(hi > _PIO4, _PIO4, np.where(hi < -_PIO4, -_PIO4, hi))
+    hi = np.where(outside, clamped, hi)
+    lo = np.where(outside, F32(0.0), lo)
+    return hi, lo, _as_u32(t) & U32(3)
+
+
+def _sin_kernel(hi: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    z = hi * hi
+    return hi + (hi * (z * _horner(z, _SIN_P)) + lo)
+
+
+def _cos_kernel(hi: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    z = hi * hi
+    return F32(1.0) - (F32(0.5) * z - (z * (z * _horner(z, _COS_P)) - hi * lo))
+
+
+def _trig_quadrant(n: np.ndarray, hi: np.ndarray, lo: np.ndarray) -> np.ndarray:
+    y = np.where((n & U32(1)) != 0, _cos_kernel(hi, lo), _sin_kernel(hi, lo))
+    return np.where((n & U32(2)) != 0, -y, y)
+
+
+def sinf(x) -> np.ndarray:
+    """Mirror of sg_sinf = sg_trig(x, 0) (x itself below 2^-12, which covers -0 and NaN)."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        hi, lo, n = _trig_reduce(x)
+        y = np.where(~(np.abs(x) >= F32(2.0**-12)), x, _trig_quadrant(n, hi, lo))
+    return _check(y)
+
+
+def cosf(x) -> np.ndarray:
+    """Mirror of sg_cosf = sg_trig(x, 1): the quadrant shifted by one."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        hi, lo, n = _trig_reduce(x)
+        y = _trig_quadrant(n + U32(1), hi, lo)
+    return _check(y)
+
+
+# ---------------------------------------------------------------- asin, atan2
+
+PIO2_HI = F32(float.fromhex("0x1.921fb6p+0"))
+_PIO2_LO = F32(float.fromhex("-0x1.777a5cp-25"))
+PI_HI = F32(float.fromhex("0x1.921fb6p+1"))
+_PI_LO = F32(float.fromhex("-0x1.777a5cp-24"))
+_PI3O4 = F32(float.fromhex("0x1.2d97c8p+1"))
+_ASIN_P = tuple(float.fromhex(h) for h in
+                ("0x1.596d5cp-5", "0x1.8c2d86p-6", "0x1.747d06p-5", "0x1.3301fcp-4",
+                 "0x1.5555c8p-3"))
+_ATAN_P = tuple(float.fromhex(h) for h in
+                ("-0x1.d32dacp-10", "0x1.6410e4p-7", "-0x1.fd6fbcp-6", "0x1.da24cap-5",
+                 "-0x1.580814p-4", "0x1.c08c1ap-4", "-0x1.242084p-3", "0x1.9991e4p-3",
+                 "-0x1.55553ep-2"))
+
+
+def _asin_tail(x: np.ndarray, z: np.ndarray) -> np.ndarray:
+    return x * (z * _horner(z, _ASIN_P))
+
+
+def asinf(x) -> np.ndarray:
+    """Mirror of sg_asinf: odd polynomial below 1/2, pi/2 - 2 asin(sqrt((1-|x|)/2)) above."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        a = np.abs(x)
+        small = np.where(a < F32(2.0**-12), x, x + _asin_tail(x, x * x))
+        z = (F32(1.0) - a) * F32(0.5)
+        s = np.sqrt(z)
+        u = F32(2.0) * _asin_tail(s, z) - _PIO2_LO
+        big = np.where(s >= F32(0.3125), (PIO2_HI - F32(2.0) * s) - u,
+                       PIO2_HI - (F32(2.0) * s + u))
+        big = np.where(x < F32(0.0), -big, big)
+        y = np.where(a < F32(0.5), small, big)
+        y = np.where(a <= F32(1.0), y, np.where(np.isnan(x), x + x, _NAN))
+    return _check(y)
+
+
+def _atan_kernel(q: np.ndarray) -> np.ndarray:
+    z = q * q
+    return q + q * (z * _horner(z, _ATAN_P))
+
+
+def _atan2_special(y, x, a, b, xneg) -> np.ndarray:
+    t = np.where(a == _INF, np.where(b == _INF, np.where(xneg, _PI3O4, _PIO4), PIO2_HI),
+                 np.where((b == _INF) | (a == F32(0.0)), np.where(xneg, PI_HI, F32(0.0)),
+                          PIO2_HI))
+    t = np.where((_as_u32(y) >> U32(31)) != 0, -t, t)
+    return np.where(np.isnan(x) | np.isnan(y), x + y, t)
+
+
+def atan2f(y, x) -> np.ndarray:
+    """Mirror of sg_atan2f(y, x): atan of min/max, quadrant fix-ups, Annex F special cases."""
+    y, x = np.broadcast_arrays(_f32(y), _f32(x))
+    with np.errstate(all="ignore"):
+        a, b = np.abs(y), np.abs(x)
+        xneg = (_as_u32(x) >> U32(31)) != 0
+        fast = (a > F32(0.0)) & (a < _INF) & (b > F32(0.0)) & (b < _INF)
+        swap = a > b
+        k = _atan_kernel(np.where(swap, b, a) / np.where(swap, a, b))
+        t = np.where(swap, PIO2_HI + (_PIO2_LO - k), k)
+        t = np.where(xneg, PI_HI + (_PI_LO - t), t)
+        t = np.where((_as_u32(y) >> U32(31)) != 0, -t, t)
+        r = np.where(fast, t, _atan2_special(y, x, a, b, xneg))
+    return _check(r)
+
+
+# ---------------------------------------------------------------- sqrt, pow
+
+def sqrtf(x) -> np.ndarray:
+    """Mirror of sg_sqrtf: IEEE sqrt is correctly rounded everywhere (VSQRT, sqrtss, numpy)."""
+    with np.errstate(all="ignore"):
+        return _check(np.sqrt(_f32(x)))
+
+
+def powf_pos(x, y) -> np.ndarray:
+    """Mirror of sg_powf_pos: 1 if y == 0 or x == 1, NaN if x < 0, else expf(y * logf(x))."""
+    x, y = np.broadcast_arrays(_f32(x), _f32(y))
+    with np.errstate(all="ignore"):
+        r = expf(y * logf(x))
+        r = np.where((y == F32(0.0)) | (x == F32(1.0)), F32(1.0),
+                     np.where(x < F32(0.0), _NAN, r))
+    return _check(r)
