@@ -84,8 +84,9 @@ _TANH_COLS = tuple(np.ascontiguousarray(_TANH_TAB[:, j]) for j in range(6))  # f
 
 
 def tanhf(x) -> np.ndarray:
-    """Mirror of sg_tanhf: interval table indexed by exponent + 3 mantissa bits, degree-4
-    polynomial in |x| - c; x itself below 2^-12, +-1 from 9 on, NaN passes."""
+    """Mirror of sg_tanhf (and of sg_inline_tanhf, its inlined form): interval table indexed by
+    exponent + 3 mantissa bits, degree-4 polynomial in |x| - c; x itself below 2^-12 and for
+    NaN, +-1 (built from the sign bit) from 9 on."""
     x = _f32(x)
     with np.errstate(all="ignore"):
         ux = _as_u32(x)
@@ -98,9 +99,9 @@ def tanhf(x) -> np.ndarray:
             p = p * t + _TANH_COLS[j].take(idx)
         neg = (ux >> U32(31)) != U32(0)
         y = np.where(neg, -p, p)
-        sat = np.where(neg, F32(-1.0), F32(1.0))
+        sat = _as_f32((ux & U32(0x80000000)) | U32(0x3F800000))  # +-1 from the sign bit
         tiny = (ux << U32(1)) < U32((_TANH_TINY_BITS << 1) & 0xFFFFFFFF)
-        out = np.where(tiny, x, np.where(np.isnan(x), x + x, sat))
+        out = np.where(tiny | np.isnan(x), x, sat)
         y = np.where(inside, y, out)
     return _check(y)
 

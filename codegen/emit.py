@@ -21,8 +21,13 @@ TEMPLATES = Path(__file__).with_name("templates")
 CSRC = Path(__file__).with_name("csrc")
 MATH_FILES = ("sg_math.h", "sg_math.c")
 DEFAULT_NAME = "network"
-# Two neurons per iteration halve the loop overhead; four made GCC 12 spill an accumulator (arm -O2).
+# Neurons per MLP loop iteration. Four would save ~11 cycles (12-40-3, ideal) but the loop, with
+# tanh inlined, then outgrows the STM32F4 ART's 1 KB instruction cache: 8,410 cycles instead of
+# 5,165 with 5 wait states (BENCHMARKS.md, issue 4).
 UNROLL_CHOICES = (2, 1)
+# Most weights of one neuron loaded back to back before their sum: 13 (bias + 12 inputs) keeps
+# the 12 inputs, 3 output sums and the group within the FPU registers of the Cortex-M4.
+LOAD_GROUP = 13
 
 
 def c_float(value) -> str:
@@ -75,10 +80,18 @@ def hidden_unroll(n_hidden: int) -> int:
     return next(u for u in UNROLL_CHOICES if n_hidden % u == 0)
 
 
+def load_groups(n_in: int) -> list[list[int]]:
+    """A hidden neuron's input weights in consumption order (0 = bias, i = W1[j][i-1]), cut into
+    groups of at most LOAD_GROUP that the C loads back to back before summing them."""
+    order = list(range(n_in + 1))
+    return [order[k:k + LOAD_GROUP] for k in range(0, len(order), LOAD_GROUP)]
+
+
 def template_context(a: Artifact, name: str) -> dict:
     env, out = a.envelope, a.outputs
     return {
         "unroll": hidden_unroll(a.n_hidden), "stride": 1 + a.n_in + a.n_out,
+        "load_groups": load_groups(a.n_in),
         "name": name, "P": name.upper(),
         "n_in": a.n_in, "n_hidden": a.n_hidden, "n_out": a.n_out,
         "sha256": a.sha256, "generator_version": GENERATOR_VERSION,

@@ -54,12 +54,12 @@ def check_targets_visible(targets: Sequence[Target], config: SimConfig) -> None:
 
 
 def validate_campaign(controller: str, targets: Sequence[Target], config: SimConfig,
-                      plan: ImagingPlan) -> functools.partial:
+                      plan: ImagingPlan, options: dict | None = None) -> functools.partial:
     """Every user error (bad controller, no imaging window, target below the horizon) raised
     before anything runs or is written; returns the picklable controller factory."""
     plan.windows(config.control_steps * config.control_period)
     make = functools.partial(build_controller, controller, torque_limit=config.spacecraft.torque_limit,
-                             control_period=config.control_period)
+                             control_period=config.control_period, **(options or {}))
     make()
     check_targets_visible(targets, config)
     return make
@@ -67,8 +67,9 @@ def validate_campaign(controller: str, targets: Sequence[Target], config: SimCon
 
 def run_campaign(controller: str, targets: Sequence[Target], config: SimConfig = SimConfig(),
                  plan: ImagingPlan = DEFAULT_PLAN, workers: int | None = None,
-                 progress: bool = True) -> CampaignResult:
-    make = validate_campaign(controller, targets, config, plan)
+                 progress: bool = True, options: dict | None = None) -> CampaignResult:
+    """options: keyword arguments of the controller factory (e.g. artifact=PATH)."""
+    make = validate_campaign(controller, targets, config, plan, options)
     start = time.perf_counter()
     histories = simulate_targets(make, [(tg.lon, tg.lat) for tg in targets], config,
                                  workers=workers, progress=progress and len(targets) > 1)

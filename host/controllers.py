@@ -49,13 +49,20 @@ class Controller(Protocol):
 # Later issues add their controllers here.
 CONTROLLERS = {
     "pid": "host.pid:make_pid_controller",
+    "nn": "host.nn_controller:make_nn_controller",
+    "nn-c": "host.sil:make_sil_controller",
+    "pid-c": "host.sil:make_sil_pid_controller",
+    "nn-arm": "host.sil:make_pil_controller",
 }
+# Controllers built from a model artifact accept `artifact=` (a file path, None = the stand-in).
+ARTIFACT_CONTROLLERS = ("nn", "nn-c", "pid-c", "nn-arm")
 
 
-def build_controller(name: str, *, torque_limit: float, control_period: float) -> Controller:
-    """Instantiate a registered controller by name; unknown names are a user error."""
+def build_controller(name: str, *, torque_limit: float, control_period: float, **options) -> Controller:
+    """Instantiate a registered controller by name; unknown names are a user error.
+    `options` go to the factory (e.g. artifact= for ARTIFACT_CONTROLLERS)."""
     if name not in CONTROLLERS:
         raise HostError(f"unknown controller {name!r} (known: {', '.join(sorted(CONTROLLERS))})")
     module, factory = CONTROLLERS[name].split(":")
     return getattr(importlib.import_module(module), factory)(
-        torque_limit=torque_limit, control_period=control_period)
+        torque_limit=torque_limit, control_period=control_period, **options)

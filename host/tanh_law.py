@@ -19,15 +19,17 @@ mirrors the sampled version.
 """
 from __future__ import annotations
 
-import json
 import math
-import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import NamedTuple
 
-import numpy as np
-
+from codegen.tanh_params import (  # noqa: F401 (TanhParamsError, load_params, params_from_mapping: re-exported)
+    TanhParams,
+    TanhParamsError,
+    derived_constants,
+    load_params,
+    params_from_mapping,
+)
 from host.errors import HostError
 
 Vec = tuple[float, float, float]
@@ -41,143 +43,9 @@ ZERO3: Vec = (0.0, 0.0, 0.0)
 
 # ----------------------------------------------------------------------------- parameters
 
-# file key -> dataclass field; "lambda" is a Python keyword.
-_GAIN_KEYS = ("k1", "k2", "k3", "k4", "k5", "eps1", "eps2", "eps3", "beta1", "beta2")
-_POSITIVE_KEYS = _GAIN_KEYS + ("eta", "n1", "lambda", "d_max")
-_REQUIRED_KEYS = _POSITIVE_KEYS + ("gamma", "inertia")
-_OPTIONAL_KEYS = ("delta_reg", "q0_min", "varpi_limit")
-_FIELD_OF_KEY = {"lambda": "lam"}
-
-
-@dataclass(frozen=True)
-class TanhParams:
-    """Parameters of law (17)-(20) with virtual rate (10)-(11); units SI (N·m, rad, rad/s, kg·m²).
-
-    k1, k2, k3   tanh amplitudes of (17) (N·m): |u_i| ≤ k1 + k2 + k3.
-    eps1..eps3   tanh slopes of (17) on ϖ, x1 and ẋ1 (not the ε1 of the adaptive law (16)).
-    k4, k5       δ feedback gain and constant term of the auxiliary system (18).
-    beta1, beta2 linear and power-law gains of the virtual rate (10).
-    gamma        exponent of f (11) and of sig(δ)^γ in (20), in (0, 1).
-    eta          switch of f (11) between its quadratic patch and sig(x)^γ.
-    n1           switch of u_a (20) between δ/‖δ‖ and sig(δ)^γ/n1^γ.
-    lam          log-barrier gain λ of (10).
-    d_max        disturbance bound (N·m) of (18) and (20); not printed in the paper.
-    inertia      J (kg·m²), symmetric positive definite, used by F (7) and J⁻¹ in (18), (20).
-    delta_reg    δᵀδ threshold *and* offset of the section 4.2 regularisation of δ/(δᵀδ).
-    q0_min       scalar part of the error quaternion below which the 180° fallback runs.
-    varpi_limit  |ϖ_i| clamp of the sampled update (overflow guard for too-long periods; never
-                 reached in the paper's example at T ≤ 0.19 s, where max |ϖ_i| < 10).
-    """
-
-    k1: float
-    k2: float
-    k3: float
-    k4: float
-    k5: float
-    eps1: float
-    eps2: float
-    eps3: float
-    beta1: float
-    beta2: float
-    gamma: float
-    eta: float
-    n1: float
-    lam: float
-    d_max: float
-    inertia: tuple[tuple[float, float, float], ...]
-    delta_reg: float = 1e-3
-    q0_min: float = 0.01
-    varpi_limit: float = 1e6
-
-    def __post_init__(self):
-        _validate(self)
-        # normalise to floats so equality, hashing and the generated constants do not depend on
-        # whether a file wrote 7 or 7.0
-        for key in _REQUIRED_KEYS + _OPTIONAL_KEYS:
-            name = _FIELD_OF_KEY.get(key, key)
-            value = getattr(self, name)
-            if name == "inertia":
-                value = tuple(tuple(float(x) for x in row) for row in value)
-            else:
-                value = float(value)
-            object.__setattr__(self, name, value)
-
-    def to_mapping(self) -> dict:
-        """The file form (keys as in a parameter file), for JSON/TOML and the C generator."""
-        out = {key: getattr(self, _FIELD_OF_KEY.get(key, key)) for key in _REQUIRED_KEYS + _OPTIONAL_KEYS}
-        out["inertia"] = [list(row) for row in self.inertia]
-        return out
-
-
-def _validate(p: TanhParams) -> None:
-    for key in _REQUIRED_KEYS + _OPTIONAL_KEYS:
-        if key == "inertia":
-            continue
-        value = getattr(p, _FIELD_OF_KEY.get(key, key))
-        if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-            raise HostError(f"'{key}' must be a finite number, got {value!r}")
-    for key in _POSITIVE_KEYS + _OPTIONAL_KEYS:
-        value = getattr(p, _FIELD_OF_KEY.get(key, key))
-        if value <= 0:
-            raise HostError(f"'{key}' = {value!r} must be > 0")
-    if not 0.0 < p.gamma < 1.0:
-        raise HostError(f"'gamma' = {p.gamma!r} must be in (0, 1)")
-    if not p.q0_min < 0.5:
-        raise HostError(f"'q0_min' = {p.q0_min!r} must be < 0.5 (it guards only the 180° neighbourhood)")
-    _validate_inertia(p.inertia)
-
-
-def _validate_inertia(inertia) -> None:
-    try:
-        J = np.array(inertia, dtype=float)
-    except (TypeError, ValueError):
-        raise HostError(f"'inertia' must be a 3x3 matrix of numbers, got {inertia!r}") from None
-    if J.shape != (3, 3) or not np.all(np.isfinite(J)):
-        raise HostError(f"'inertia' must be a finite 3x3 matrix, got shape {J.shape}")
-    if not np.allclose(J, J.T, rtol=0, atol=1e-12 * np.max(np.abs(J))):
-        raise HostError("'inertia' must be symmetric")
-    if np.min(np.linalg.eigvalsh(J)) <= 0:
-        raise HostError("'inertia' must be positive definite")
-
-
-def params_from_mapping(data: dict) -> TanhParams:
-    """Build validated parameters from a parameter-file mapping; errors are one-line HostErrors."""
-    if not isinstance(data, dict):
-        raise HostError(f"parameters must be a table/object, got {type(data).__name__}")
-    unknown = sorted(set(data) - set(_REQUIRED_KEYS) - set(_OPTIONAL_KEYS))
-    if unknown:
-        raise HostError(f"unknown key '{unknown[0]}'")
-    for key in _REQUIRED_KEYS:
-        if key not in data:
-            raise HostError(f"missing key '{key}'")
-    kwargs = {_FIELD_OF_KEY.get(k, k): v for k, v in data.items()}
-    inertia = kwargs["inertia"]
-    if isinstance(inertia, (list, tuple)) and all(isinstance(r, (list, tuple)) for r in inertia):
-        kwargs["inertia"] = tuple(tuple(r) for r in inertia)
-    return TanhParams(**kwargs)
-
-
-def load_params(path: str | Path) -> TanhParams:
-    """Read a .toml or .json parameter file (flat keys, see TanhParams) and validate it."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise HostError(f"{path}: cannot read parameter file ({exc.strerror})") from None
-    try:
-        if path.suffix == ".toml":
-            data = tomllib.loads(raw.decode("utf-8"))
-        elif path.suffix == ".json":
-            data = json.loads(raw)
-        else:
-            raise HostError(f"{path}: parameter file must end in .toml or .json")
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        first_line = str(exc).splitlines()[0]
-        raise HostError(f"{path}: not valid {path.suffix[1:].upper()}: {first_line}") from None
-    try:
-        return params_from_mapping(data)
-    except HostError as exc:
-        raise HostError(f"{path}: {exc}") from None
+# The parameter file schema and its one validator (TanhParams, load_params, params_from_mapping;
+# errors are codegen.tanh_params.TanhParamsError) live in codegen.tanh_params: the C generator
+# reads them and codegen must not import host. Imported above and re-exported.
 
 
 # ----------------------------------------------------------------------------- derived constants
@@ -198,19 +66,18 @@ class LawConstants:
 
 
 def compile_constants(params: TanhParams) -> LawConstants:
-    J = np.array(params.inertia, dtype=float)
-    J_inv = np.linalg.inv(J)
-    J_inv_norm = float(np.linalg.norm(J_inv, 2))
-    g, eta = params.gamma, params.eta
+    """The derived constants of codegen.tanh_params.derived_constants (the C generator rounds the
+    same float64 values to float32), as float tuples."""
+    d = derived_constants(params)
     return LawConstants(
         params=params,
-        J=_as_mat(J),
-        J_inv=_as_mat(J_inv),
-        J_inv_norm=J_inv_norm,
-        r1=(2.0 - g) * eta ** (g - 1.0),
-        r2=(g - 1.0) * eta ** (g - 2.0),
-        ua_gain=J_inv_norm * params.d_max,
-        ua_inner_scale=J_inv_norm * params.d_max / params.n1 ** g,
+        J=_as_mat(d["J"]),
+        J_inv=_as_mat(d["J_inv"]),
+        J_inv_norm=d["J_inv_norm"],
+        r1=d["r1"],
+        r2=d["r2"],
+        ua_gain=d["ua_gain"],
+        ua_inner_scale=d["ua_inner_scale"],
     )
 
 

@@ -30,7 +30,9 @@ WRAPPERS = "\n".join(
     [f"void batch_{n}(const float *x, float *y, int n) {{ for (int i = 0; i < n; i++) "
      f"y[i] = sg_{n}(x[i]); }}" for n in UNARY]
     + [f"void batch_{n}(const float *a, const float *b, float *y, int n) {{ for (int i = 0; "
-       f"i < n; i++) y[i] = sg_{n}(a[i], b[i]); }}" for n in BINARY])
+       f"i < n; i++) y[i] = sg_{n}(a[i], b[i]); }}" for n in BINARY]
+    + ["void batch_inline_tanhf(const float *x, float *y, int n) { for (int i = 0; i < n; i++) "
+       "y[i] = sg_inline_tanhf(x[i]); }"])
 
 
 OPT_LEVELS = ["-O2", "-O0", "-Os"]  # the flight level and the benchmark levels (with_opt)
@@ -46,7 +48,7 @@ def clib(request, tmp_path_factory):
     subprocess.run(["gcc", *with_opt(COMMON, request.param), "-fPIC", "-shared", "-I", str(CSRC),
                     str(CSRC / "sg_math.c"), str(d / "wrap.c"), "-o", str(so)], check=True)
     ffi = cffi.FFI()
-    ffi.cdef("\n".join([f"void batch_{n}(const float *, float *, int);" for n in UNARY]
+    ffi.cdef("\n".join([f"void batch_{n}(const float *, float *, int);" for n in [*UNARY, "inline_tanhf"]]
                        + [f"void batch_{n}(const float *, const float *, float *, int);"
                           for n in BINARY]))
     lib = ffi.dlopen(str(so))
@@ -99,6 +101,16 @@ def test_twin_equals_c_unary(clib, name):
     y_c = clib(name, x)
     bad = ~same(y_twin, y_c)
     assert not bad.any(), (name, x[bad][:5].view(np.uint32), y_twin[bad][:5], y_c[bad][:5])
+
+
+def test_inline_tanh_is_sg_tanhf_bit_for_bit(clib):
+    """sg_inline_tanhf (sg_math.h, the network loop's tanh) and sg_tanhf give the same bits, NaN
+    payloads included: every argument class of both paths, at each optimisation level."""
+    rng = np.random.default_rng(7)
+    x = np.concatenate([unary_inputs("tanhf", rng), SPECIALS, -SPECIALS,
+                        rng.integers(0, 2**32, 60_000, dtype=np.uint64).astype(np.uint32).view(F32)])
+    a, b = clib("inline_tanhf", x), clib("tanhf", x)
+    assert np.array_equal(a.view(np.uint32), b.view(np.uint32))
 
 
 @pytest.mark.parametrize("name", BINARY)

@@ -293,7 +293,7 @@ def test_parameter_file_errors_are_precise_one_liners(tmp_path, suffix, edit, me
     data = PARAMS.to_mapping()
     edit(data)
     path = write_params(tmp_path, data, suffix)
-    with pytest.raises(HostError) as info:
+    with pytest.raises(tl.TanhParamsError) as info:
         tl.load_params(path)
     text = str(info.value)
     assert "\n" not in text
@@ -303,7 +303,7 @@ def test_parameter_file_errors_are_precise_one_liners(tmp_path, suffix, edit, me
 def test_parameter_file_syntax_error_is_one_line(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text("k1 = = 1\n")
-    with pytest.raises(HostError, match=r"bad\.toml: not valid TOML") as info:
+    with pytest.raises(tl.TanhParamsError, match=r"bad\.toml: not valid TOML") as info:
         tl.load_params(path)
     assert "\n" not in str(info.value)
 

@@ -13,11 +13,6 @@
 
 #include "sg_math.h"
 
-typedef union {
-    float f;
-    uint32_t u;
-} sg_bits_t;
-
 static uint32_t sg_as_u32(float f)
 {
     sg_bits_t b;
@@ -38,18 +33,17 @@ static float sg_as_f32(uint32_t u)
 /* ------------------------------------------------------------------ tanh */
 
 /*
+ * (SG_TANH_M, SG_TANH_FIRST, SG_TANH_N, sg_tanh_index, sg_tanh_poly: sg_math.h, shared with
+ * sg_inline_tanhf.)
  * |x| in [2^-12, 9) is cut into 121 intervals, 8 per binade, indexed by the exponent and the
  * top 3 mantissa bits of x (one shift pair, one unsigned compare that also sends tiny, huge,
  * Inf and NaN arguments out of line). On each, tanh(c + t) = c0 + t (c1 + t (c2 + t (c3 +
  * t c4))), t = |x| - c (exact), c the interval's midpoint: a minimax fit for relative error
- * (tools/fit_minimax.py --tanh-table). No division: ~40 Cortex-M4 cycles with the call.
+ * (tools/fit_minimax.py --tanh-table). No division: ~20 Cortex-M4 cycles inlined in the
+ * network loop (sg_inline_tanhf), ~31 as a call.
  */
-#define SG_TANH_M 3u                           /* mantissa bits in the index */
-#define SG_TANH_FIRST ((127u - 12u) << SG_TANH_M) /* index of [2^-12, 1.125 * 2^-12) */
-#define SG_TANH_N 121u                         /* the last interval is [8, 9) */
-#define SG_TANH_TINY_BITS 0x39800000u           /* 2^-12: below, tanh x rounds to x */
 
-static const float sg_tanh_tab[SG_TANH_N][6] = {
+const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] = {
     /* BEGIN sg_tanh_tab: c, c0, c1, c2, c3, c4 */
     {0x1.1p-12f, 0x1.1p-12f, 0x1.fffffep-1f, -0x1.100012p-12f, -0x1.554f5cp-2f, 0x1.807d22p+0f},
     {0x1.3p-12f, 0x1.3p-12f, 0x1.fffffep-1f, -0x1.2ffff4p-12f, -0x1.554af4p-2f, 0x1.91be34p-2f},
@@ -175,34 +169,34 @@ static const float sg_tanh_tab[SG_TANH_N][6] = {
     /* END sg_tanh_tab */
 };
 
-/* |x| < 2^-12 (also +-0, subnormals): x; NaN: NaN; |x| >= 9: +-1 (within 0.52 ulp). */
-static float sg_tanh_outside(float x, uint32_t ux)
+/* Magnitude bits of x (2 per ulp) above those of 2^-12, the start of interval 0: the interval
+ * is d >> (24 - SG_TANH_M), i.e. sg_tanh_index(ux), and d >= SG_TANH_D_END outside [2^-12, 9). */
+#define SG_TANH_SHIFT (24u - SG_TANH_M)
+#define SG_TANH_D_END (SG_TANH_N << SG_TANH_SHIFT)
+#define SG_TANH_D_INF (0xff000000u - (SG_TANH_FIRST << SG_TANH_SHIFT)) /* d of +-Inf */
+
+/* Outside [2^-12, 9): x itself for NaN (NaN in, NaN out) and for |x| < 2^-12 (also +-0,
+ * subnormals: d wrapped around), else +-1 (|x| >= 9, +-Inf; tanh 9 is within 0.52 ulp of 1).
+ * One unsigned compare: a network row with an infinite or NaN input comes here once per hidden
+ * neuron. */
+static float sg_tanh_outside(float x, uint32_t ux, uint32_t d)
 {
-    if ((ux << 1) < (SG_TANH_TINY_BITS << 1)) {
+    if (d > SG_TANH_D_INF) {
         return x;
     }
-    if (x != x) {
-        return x + x;
-    }
-    return (ux >> 31) ? -1.0f : 1.0f;
+    return sg_as_f32((ux & 0x80000000u) | 0x3f800000u); /* +-1 from the sign bit: no IT block */
 }
 
-/* tanh(x) = MATLAB tansig(x); odd: the sign is applied last from the sign bit. */
+/* tanh(x) = MATLAB tansig(x); odd: the sign is applied last from the sign bit. The interval
+ * comes from d (same value as sg_tanh_index(ux)), which the out-of-range path reuses. */
 float sg_tanhf(float x)
 {
     uint32_t ux = sg_as_u32(x);
-    uint32_t i = ((ux << 1) >> (24u - SG_TANH_M)) - SG_TANH_FIRST;
-    if (__builtin_expect(i >= SG_TANH_N, 0)) {
-        return sg_tanh_outside(x, ux);
+    uint32_t d = (ux << 1) - (SG_TANH_FIRST << SG_TANH_SHIFT);
+    if (__builtin_expect(d >= SG_TANH_D_END, 0)) {
+        return sg_tanh_outside(x, ux, d);
     }
-    const float *c = sg_tanh_tab[i];
-    float t = __builtin_fabsf(x) - c[0];
-    float p = c[5];
-    p = p * t + c[4];
-    p = p * t + c[3];
-    p = p * t + c[2];
-    p = p * t + c[1];
-    return (ux >> 31) ? -p : p;
+    return sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, ux);
 }
 
 /* ------------------------------------------------------------------ exp */

@@ -22,11 +22,14 @@ COMMANDS = [
     "host.cli.simulate",
     "host.cli.pipeline",
     "host.cli.samples",
+    "host.cli.train",
     "host.cli.artifact",
     "host.cli.codegen",
     "host.cli.c_eval",
     "host.cli.verify",
     "host.cli.cycles",
+    "host.cli.impulse",
+    "host.cli.tanh",
 ]
 
 

@@ -1,4 +1,7 @@
-"""`staregen cycles --artifact FILE [--mode ideal|art|pessimistic|all] [--json FILE] [--md FILE]`.
+"""`staregen cycles [--entry network] --artifact FILE [--mode ideal|art|pessimistic|all] [--json FILE] [--md FILE]`,
+`staregen cycles --entry tanh --params FILE [--period S] [--mode ...]` (paper 000's tanh law step),
+`staregen cycles --entry controller [--artifact FILE] [--mode ...]` (the whole Fig. 2 step, NN and
+PID paths reported apart; host/controller_cycles.py).
 
 Generates the network path C from the artifact, builds the STM32F417 ELF, runs input classes
 (inside the envelope, on its bounds, outside it, special values) through the harness in the
@@ -27,7 +30,13 @@ BUDGET_STACK = 512
 
 def register(subparsers) -> None:
     parser = subparsers.add_parser("cycles", help="cycle, memory and stack report of the ARM build (emulated Cortex-M4)")
-    parser.add_argument("--artifact", required=True, metavar="FILE")
+    parser.add_argument("--entry", default="network", choices=sorted(ENTRIES),
+                        help="entry point: network (needs --artifact, default), controller (the whole Fig. 2 "
+                             "step; --artifact, default the stand-in) or tanh (needs --params)")
+    parser.add_argument("--artifact", metavar="FILE", help="model artifact (entry network)")
+    parser.add_argument("--params", metavar="FILE", help="tanh-law parameter file, .toml/.json (entry tanh)")
+    parser.add_argument("--period", type=float, default=0.1, metavar="S",
+                        help="control period baked into the tanh step, s (entry tanh; default 0.1)")
     parser.add_argument("--mode", default="ideal", choices=[*MODES, "all"],
                         help="flash memory model (default ideal: 0 wait states); all = the three")
     parser.add_argument("--per-class", type=int, default=DEFAULT_PER_CLASS, metavar="N",
@@ -135,12 +144,11 @@ def text_report(name: str, entry: dict, facts: dict, modes) -> list[str]:
     return lines
 
 
-def run(args: argparse.Namespace) -> int:
+def run_network(args: argparse.Namespace, modes) -> int:
     from codegen import artifact as art
 
-    if args.per_class < 1:
-        raise HostError(f"--per-class: need at least 1, got {args.per_class}")
-    modes = MODES if args.mode == "all" else (args.mode,)
+    if not args.artifact:
+        raise HostError("--entry network needs --artifact FILE")
     a = art.load(args.artifact)
     name = "network"
     entry, facts = network_report(a, name, modes, args.per_class, args.seed)
@@ -153,3 +161,54 @@ def run(args: argparse.Namespace) -> int:
         atomic.write_text(args.md, f"# Cycle report: {args.artifact} ({a.shape_text})\n\n" + "\n".join(lines) + "\n")
         print(f"wrote {args.md}")
     return 0
+
+
+def run_tanh(args: argparse.Namespace, modes) -> int:
+    """tanh_step of paper 000's saturation law (host/tanh_sil.py builds, classes, report)."""
+    from codegen.tanh_params import load_params
+    from host import tanh_sil
+
+    if not args.params:
+        raise HostError("--entry tanh needs --params FILE (e.g. docs/tanh_paper000.toml)")
+    if not (np.isfinite(args.period) and args.period > 0):
+        raise HostError(f"--period must be a positive number of seconds, got {args.period}")
+    rep = tanh_sil.cycle_report(load_params(args.params), args.period, modes, args.per_class, args.seed)
+    lines = tanh_sil.cycle_text(rep)
+    print("\n".join(lines))
+    if args.json:
+        atomic.write_json(args.json, {"entries": {"tanh": rep}})
+        print(f"wrote {args.json}")
+    if args.md:
+        atomic.write_text(args.md, f"# Cycle report: tanh law, {args.params}\n\n" + "\n".join(lines) + "\n")
+        print(f"wrote {args.md}")
+    return 0
+
+
+def run_controller(args: argparse.Namespace, modes) -> int:
+    """The whole controller step of Fig. 2 (host/controller_cycles.py): NN and PID paths apart."""
+    from host import controller_cycles
+    from host.nn_controller import flight_config, load_artifact
+
+    a = load_artifact(args.artifact)   # None: the stand-in network fitted to the PID law
+    rep = controller_cycles.cycle_report(a, flight_config(), modes, args.per_class, args.seed)
+    lines = controller_cycles.cycle_text(rep)
+    print("\n".join(lines))
+    if args.json:
+        atomic.write_json(args.json, {"entries": {"controller": rep}})
+        print(f"wrote {args.json}")
+    if args.md:
+        atomic.write_text(args.md, f"# Cycle report: controller step, {args.artifact or 'stand-in network'}\n\n"
+                          + "\n".join(lines) + "\n")
+        print(f"wrote {args.md}")
+    return 0
+
+
+# Entry points the report knows: name -> handler(args, modes).
+ENTRIES = {"network": run_network, "tanh": run_tanh, "controller": run_controller}
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.per_class < 1:
+        raise HostError(f"--per-class: need at least 1, got {args.per_class}")
+    modes = MODES if args.mode == "all" else (args.mode,)
+    return ENTRIES[args.entry](args, modes)

@@ -1,8 +1,8 @@
 """`staregen pipeline`: the whole flow on the default preset, as a sequence of stage functions.
 
-Stages: scenario summary; the central-target PID simulation (<out>/pid_central/); the network
-artifact (<out>/network.json: a stand-in fitted to the PID law until sample creation and training
-join the pipeline); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
+Stages: scenario summary; the central-target PID simulation (<out>/pid_central/); optimal-control
+samples on Dask (<out>/samples/, the `regularised` objective); training of the 12-40-3 tansig
+network on them (<out>/network.json, <out>/training.md); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
 ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); a
 report (report.json, report.txt). The output folder is built atomically: a failed stage leaves
 no partial folder.
@@ -70,16 +70,35 @@ GATE_SEED = 0
 CYCLES_PER_CLASS = 100
 
 
-def stage_network(ctx: PipelineContext) -> None:
-    """The network artifact the flight C is generated from (stand-in: fitted to the PID law)."""
-    from host.standin import fit_pid_standin
+PRESET_SAMPLES = 2_000
 
-    a = fit_pid_standin(seed=PRESET_SEED)
-    a.save(ctx.out / "network.json")
+
+def stage_samples(ctx: PipelineContext) -> None:
+    """Optimal-control samples (CasADi/IPOPT) on a Dask LocalCluster, sharded as `staregen samples`."""
+    from host.ocp import OcpConfig
+    from host.samples import DatasetPlan, create_dataset, load_dataset
+
+    plan = DatasetPlan(n_samples=PRESET_SAMPLES, ocp=OcpConfig(), master_seed=PRESET_SEED).validate()
+    run = create_dataset(ctx.out / "samples", plan, progress=True)
+    _, _, _, report = load_dataset(ctx.out / "samples")
+    ctx.results["samples"] = {"n": report["n_total"], "used": report["n_used"], "objective": plan.ocp.objective,
+                              "samples_per_second": run["samples_per_second"], "workers": run["workers"]}
+    ctx.report.append(f"samples: {report['n_total']} ({plan.ocp.objective}), {report['n_used']} usable, "
+                      f"{run['samples_per_second']:.1f} samples/s on {run['workers']} workers")
+
+
+def stage_train(ctx: PipelineContext) -> None:
+    """The 12-40-3 tansig network trained on the samples; its artifact feeds codegen."""
+    from host import training
+
+    a, report = training.train_artifact(ctx.out / "samples", recipe="default", seed=PRESET_SEED)
+    training.save_artifact(a, ctx.out / "network.json")
+    atomic.write_text(ctx.out / "training.md", report.summary() + "\n")
     ctx.artifact = a
     ctx.results["network"] = {"artifact": "network.json", "shape": a.shape_text, "sha256": a.sha256,
-                              "kind": "stand-in fitted to the Table 1 PID law"}
-    ctx.report.append(f"network: {a.shape_text} stand-in (fitted to the PID law), sha256 {a.sha256[:16]}…")
+                              "relative_torque_error": report.net.get("relative_torque_error"),
+                              "train_seconds": round(report.train_seconds, 2)}
+    ctx.report.append(report.summary())
 
 
 def stage_codegen(ctx: PipelineContext) -> None:
@@ -118,7 +137,7 @@ def stage_cycles(ctx: PipelineContext) -> None:
                              "ram_bytes": entry["ram_bytes"], "stack_bytes": entry["stack_bytes"]}
     ctx.report.append("cycles (network path, worst case): " + ", ".join(f"{m} {c}" for m, c in worst.items())
                       + f"; flash {entry['flash_bytes']} B, RAM {entry['ram_bytes']} B, stack {entry['stack_bytes']} B"
-                      + f" (paper: 3.3 ms = 554,400 cycles)")
+                      + " (paper: 3.3 ms = 554,400 cycles)")
 
 
 def stage_report(ctx: PipelineContext) -> None:
@@ -126,7 +145,7 @@ def stage_report(ctx: PipelineContext) -> None:
     atomic.write_text(ctx.out / "report.txt", "\n\n".join(ctx.report) + "\n")
 
 
-STAGES = [stage_scenario, stage_pid_central, stage_network, stage_codegen, stage_gate, stage_cycles,
+STAGES = [stage_scenario, stage_pid_central, stage_samples, stage_train, stage_codegen, stage_gate, stage_cycles,
           stage_report]
 
 

@@ -6,9 +6,8 @@ Rerunning the same command resumes: finished shards are validated and kept, the 
 """
 from __future__ import annotations
 
-import math
 
-from host.errors import HostError
+from host.cli.args import parse_int, parse_number
 from host.ocp import OBJECTIVES, OcpConfig
 from host.samples import DEFAULT_SHARD_SIZE, DatasetPlan, create_dataset, load_dataset, timing_summary
 
@@ -34,44 +33,24 @@ def register(subparsers) -> None:
     p.set_defaults(func=main)
 
 
-def _int(text: str, what: str, minimum: int) -> int:
-    try:
-        value = int(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be an integer, got {text!r}") from None
-    if value < minimum:
-        raise HostError(f"{what} must be at least {minimum}, got {value}")
-    return value
-
-
-def _positive(text: str, what: str) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be a number, got {text!r}") from None
-    if not (math.isfinite(value) and value > 0):
-        raise HostError(f"{what} must be a positive number, got {text!r}")
-    return value
-
-
 def _torque_bound(text: str | None) -> float | None:
     if text is None:
         return OcpConfig().torque_bound
     if text.lower() == "none":
         return None
-    return _positive(text, "--torque-bound")
+    return parse_number(text, "--torque-bound", positive=True)
 
 
 def main(args) -> int:
-    n = _int(args.n, "--n (the number of samples)", 1)
+    n = parse_int(args.n, "--n (the number of samples)", 1)
     plan = DatasetPlan(
         n_samples=n,
         ocp=OcpConfig(objective=args.objective, torque_bound=_torque_bound(args.torque_bound)),
-        master_seed=_int(args.seed, "--seed", 0),
-        shard_size=_int(args.shard_size, "--shard-size", 1),
+        master_seed=parse_int(args.seed, "--seed", 0),
+        shard_size=parse_int(args.shard_size, "--shard-size", 1),
     ).validate()
-    workers = None if args.workers is None else _int(args.workers, "--workers", 1)
-    timeout = _positive(args.connect_timeout, "--connect-timeout")
+    workers = None if args.workers is None else parse_int(args.workers, "--workers", 1)
+    timeout = parse_number(args.connect_timeout, "--connect-timeout", positive=True)
     run = create_dataset(args.out, plan, scheduler=args.scheduler, workers=workers,
                          connect_timeout=timeout, progress=not args.no_progress)
     _, _, _, report = load_dataset(args.out)

@@ -7,9 +7,9 @@ place only when complete, so a failure leaves no partial output.
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
+from host.cli.args import parse_int, parse_number
 from host.campaign import format_table, run_campaign, validate_campaign, write_campaign
 from host.controllers import CONTROLLERS
 from host.errors import HostError
@@ -26,10 +26,14 @@ def register(subparsers) -> None:
                               description=__doc__.splitlines()[0])
     p.add_argument("--controller", default="pid",
                    help=f"controller ({', '.join(sorted(CONTROLLERS))}, or 'tanh' for the paper-000 "
-                        "finite-time example; default pid)")
+                        "finite-time example, 'tanh-c' / 'tanh-arm' for it with the generated C in the loop: "
+                        "SIL x86 / PIL ARM emulator; default pid)")
     p.add_argument("--period", default=None,
                    help="tanh only: control period in s (zero-order hold); omitted = continuous reference")
     p.add_argument("--dt", default=None, help="tanh only: plant RK4 step in s (default 5e-4)")
+    p.add_argument("--artifact", default=None, metavar="FILE",
+                   help="model artifact for the network controllers (nn, nn-c, pid-c, nn-arm); "
+                        "default: a stand-in network fitted to the PID law")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
     p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
@@ -39,30 +43,6 @@ def register(subparsers) -> None:
     p.add_argument("--workers", default=None, help="worker processes for several targets (default: all cores)")
     p.add_argument("--out", default="out/simulate", help="output folder (default out/simulate)")
     p.set_defaults(func=main)
-
-
-def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False) -> float:
-    try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be a number, got {text!r}") from None
-    if not math.isfinite(value):
-        raise HostError(f"{what} must be finite, got {text!r}")
-    if positive and value <= 0:
-        raise HostError(f"{what} must be positive, got {text}")
-    if non_negative and value < 0:
-        raise HostError(f"{what} must not be negative, got {text}")
-    return value
-
-
-def parse_int(text: str, what: str, minimum: int = 0) -> int:
-    try:
-        value = int(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be an integer, got {text!r}") from None
-    if value < minimum:
-        raise HostError(f"{what} must be at least {minimum}, got {value}")
-    return value
 
 
 def check_output_folder(out: Path, marker: str = "metrics.json") -> None:
@@ -93,43 +73,73 @@ def build_plan(args) -> ImagingPlan:
 
 
 def run_tanh_example(args: argparse.Namespace) -> int:
-    """The paper-000 example (section 4.2) flown by the tanh saturation law; metrics.json + Figs. 5-8."""
+    """The paper-000 example (section 4.2) flown by the tanh saturation law; metrics.json + Figs. 5-8.
+    tanh: the float64 law (continuous without --period); tanh-c / tanh-arm: the generated C in the
+    loop (SIL / PIL, --period default 0.1 s) compared with the float64 sampled run."""
     from host import tanh_example  # the staring scenario does not need it
 
     duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else "40",
                             "--duration", positive=True)
+    in_loop = {"tanh-c": "x86", "tanh-arm": "arm"}.get(args.controller)
     period = None if args.period is None else parse_number(args.period, "--period", positive=True)
+    if in_loop and period is None:
+        period = 0.1
     dt = parse_number(args.dt or str(tanh_example.MAX_REFERENCE_STEP), "--dt", positive=True)
     out = Path(args.out)
     check_output_folder(out)
     try:
         with atomic.directory(out) as tmp:
-            result = tanh_example.run(period, duration, dt, out_dir=tmp)
+            if in_loop:
+                from host import tanh_sil
+
+                result = tanh_sil.run_in_loop(in_loop, period, duration, dt, out_dir=tmp)
+            else:
+                result = tanh_example.run(period, duration, dt, out_dir=tmp)
     except OSError as exc:
         raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
     m = result["metrics"]
     mode = "continuous (RK4 %g s)" % dt if period is None else "sampled every %g s" % period
-    print(f"tanh law, paper-000 example, {mode}, {duration:g} s")
-    for key, unit in (("t_settle", "s"), ("e_final", ""), ("we_final", "rad/s"), ("u_max", "N*m")):
-        print(f"  {key:9s} {m[key]!s:>14} {unit}")
+    print(f"tanh law, paper-000 example, {mode}, {duration:g} s" + (f", {m['mode']}" if in_loop else ""))
+    keys = [("t_settle", "s"), ("e_final", ""), ("we_final", "rad/s"), ("u_max", "N*m")]
+    if in_loop:
+        keys += [("golden_mismatch_steps", ""), ("e_diff_max", ""), ("e_diff_after_25s", "")]
+        keys += [("cycles_median", ""), ("cycles_max", "")] if in_loop == "arm" else []
+    for key, unit in keys:
+        print(f"  {key:21s} {m[key]!s:>22} {unit}")
     print(f"wrote {out}/metrics.json")
     return 0
 
 
+def controller_options(args) -> dict:
+    """Factory options: the artifact of a network controller (checked here: a clear user error)."""
+    from host.controllers import ARTIFACT_CONTROLLERS
+
+    if args.controller not in ARTIFACT_CONTROLLERS:
+        if args.artifact is not None:
+            raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")
+        return {}
+    if args.artifact is not None:
+        from codegen import artifact as art
+
+        art.load(args.artifact)   # a missing or invalid file is reported before anything runs
+    return {"artifact": args.artifact}
+
+
 def main(args: argparse.Namespace) -> int:
-    if args.controller == "tanh":
+    if args.controller in ("tanh", "tanh-c", "tanh-arm"):
         return run_tanh_example(args)
     if args.period is not None or args.dt is not None:
         raise HostError("--period and --dt apply to --controller tanh only")
     targets = parse_target(args.target)
     config, plan = build_config(args), build_plan(args)
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
+    options = controller_options(args)
     out = Path(args.out)
     check_output_folder(out)
-    validate_campaign(args.controller, targets, config, plan)
+    validate_campaign(args.controller, targets, config, plan, options)
     try:
         with atomic.directory(out) as tmp:
-            result = run_campaign(args.controller, targets, config, plan, workers=workers)
+            result = run_campaign(args.controller, targets, config, plan, workers=workers, options=options)
             write_campaign(result, tmp)
     except OSError as exc:
         raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None

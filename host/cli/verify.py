@@ -33,6 +33,11 @@ def register(subparsers) -> None:
     parser.add_argument("--vectors", type=int, default=DEFAULT_VECTORS, metavar="N",
                         help=f"number of vectors (default {DEFAULT_VECTORS})")
     parser.add_argument("--seed", type=int, default=0, help="vector seed (default 0)")
+    parser.add_argument("--controller", action="store_true",
+                        help="gate the whole controller step (Fig. 2) instead of the network path: "
+                             "N independent steps plus --sequences runs of 1,000 steps")
+    parser.add_argument("--sequences", type=int, default=20, metavar="S",
+                        help="--controller: sequences of 1,000 consecutive steps (default 20)")
     parser.set_defaults(func=run)
 
 
@@ -84,4 +89,19 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--vectors: need at least 1, got {args.vectors}")
     a = art.load(args.artifact)
     print(f"artifact {args.artifact}: {a.shape_text}, sha256 {a.sha256}")
+    if args.controller:
+        return run_controller_gate(a, args)
     return 0 if run_gate(a, args.vectors, args.seed, gate_targets(args.target)) else 1
+
+
+def run_controller_gate(a: art.Artifact, args: argparse.Namespace) -> int:
+    from host import controller_gate
+    from host.nn_controller import flight_config
+
+    if args.sequences < 0:
+        raise HostError(f"--sequences: must not be negative, got {args.sequences}")
+    start = time.perf_counter()
+    ok = controller_gate.run_gate(a, flight_config(), args.vectors, args.sequences, 1000, args.seed,
+                                  targets=gate_targets(args.target))
+    print(f"total {time.perf_counter() - start:.2f} s: {'PASS' if ok else 'FAIL'}")
+    return 0 if ok else 1

@@ -1,0 +1,240 @@
+"""Golden model of the generated tanh-law step (codegen/templates/tanh.c.j2), numpy float32.
+
+Operation for operation and in the same order as the C, vectorised across N independent
+states: a 3-vector is a tuple of three (N,) float32 arrays, R_e nine of them; every C branch
+is a mask (np.where), both sides computed, the taken one kept. Sums are written out left to
+right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin): tanhf,
+logf, expf, sqrtf; |x|^γ = expf(γ·logf|x|) as in the C. Constants are the float32 values of
+codegen.tanh_emit.constants32, the same ones the C carries as hex floats. Every stage
+asserts float32 (numpy 2 promotes float32 with a float64 scalar).
+
+Records use the C struct layouts: input (N, 27) = R_c[9], w_c[3], R_t[9], w_t[3], wdot_t[3];
+state (N, 3) = varpi; output (N, 13) = torque[3], x1[3], x2[3], varpi[3], status (uint32 bits,
+viewed as float32 in the record).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from codegen import detmath
+from codegen.tanh_emit import Constants32
+
+F32 = np.float32
+N_IN = 27
+N_STATE = 3
+N_OUT = 13
+STATUS_OK, STATUS_SINGULAR, STATUS_INVALID_INPUT = 0, 1, 2
+# Input record fields: name -> column slice.
+FIELDS = {"R_c": slice(0, 9), "w_c": slice(9, 12), "R_t": slice(12, 21), "w_t": slice(21, 24),
+          "wdot_t": slice(24, 27)}
+OUT_FIELDS = {"torque": slice(0, 3), "x1": slice(3, 6), "x2": slice(6, 9), "varpi": slice(9, 12),
+              "status": slice(12, 13)}
+
+
+def _f32(a, what: str = "stage"):
+    assert a.dtype == F32, f"golden_tanh {what}: expected float32, got {a.dtype}"
+    return a
+
+
+def _v(*parts):
+    return tuple(_f32(p) for p in parts)
+
+
+def dot(a, b):
+    return _f32((a[0] * b[0] + a[1] * b[1]) + a[2] * b[2], "dot")
+
+
+def cross(a, b):
+    return _v(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def mat_vec(m, v):
+    return _v((m[0] * v[0] + m[1] * v[1]) + m[2] * v[2], (m[3] * v[0] + m[4] * v[1]) + m[5] * v[2],
+              (m[6] * v[0] + m[7] * v[1]) + m[8] * v[2])
+
+
+def mat_t_vec(m, v):
+    return _v((m[0] * v[0] + m[3] * v[1]) + m[6] * v[2], (m[1] * v[0] + m[4] * v[1]) + m[7] * v[2],
+              (m[2] * v[0] + m[5] * v[1]) + m[8] * v[2])
+
+
+def error_matrix(rt, rc):
+    """R_e = R_tᵀ R_c, nine (N,) arrays, row-major."""
+    return tuple(_f32((rt[i] * rc[j] + rt[3 + i] * rc[3 + j]) + rt[6 + i] * rc[6 + j])
+                 for i in range(3) for j in range(3))
+
+
+def e_apply(q0, e, v):
+    c = cross(e, v)
+    return _v(*(F32(0.5) * (q0 * v[i] + c[i]) for i in range(3)))
+
+
+def e_solve(q0, inv_q0, kk, e, v):
+    c = cross(e, v)
+    ev = dot(e, v) * inv_q0
+    return _v(*(kk * ((q0 * v[i] - c[i]) + e[i] * ev) for i in range(3)))
+
+
+def shaping(k: Constants32, x):
+    """(f(x), f'(x)) of eq. 11 as the C computes them."""
+    ax = np.abs(x)
+    inside = ax <= k.eta
+    p = detmath.expf(k.gamma * detmath.logf(ax))
+    f = np.where(inside, k.r1 * x + (k.r2 * x) * ax, np.where(x < F32(0.0), -p, p))
+    slope = np.where(inside, k.r1 + k.r2x2 * ax, (k.gamma * p) / ax)
+    return _f32(f, "shaping"), _f32(slope, "shaping slope")
+
+
+def sig_pow(k: Constants32, d):
+    p = detmath.expf(k.gamma * detmath.logf(np.abs(d)))
+    return _f32(np.where(d < F32(0.0), -p, p), "sig_pow")
+
+
+def force_terms(k: Constants32, re, w_c, w_e, wdot_t, w_ev_dot, u):
+    """a = F − J ω̇_ev + u formed as −ω_c×Jω_c − J(ω_c×ω_e + R_eᵀω̇_t + ω̇_ev) + u (one J product)."""
+    J = tuple(k.J)
+    gyro = cross(w_c, mat_vec(J, w_c))
+    inner = cross(w_c, w_e)
+    feed = mat_t_vec(re, wdot_t)
+    j_sum = mat_vec(J, _v(*((inner[i] + feed[i]) + w_ev_dot[i] for i in range(3))))
+    return _v(*((-gyro[i] - j_sum[i]) + u[i] for i in range(3)))
+
+
+def compensation(k: Constants32, delta, dsq):
+    norm = detmath.sqrtf(dsq)
+    outer = norm > k.n1
+    kk = k.ua_gain / norm
+    return _v(*(np.where(outer, kk * delta[i], k.ua_inner * sig_pow(k, delta[i])) for i in range(3)))
+
+
+def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
+    """(u, vdot, x2) of law (10)-(20), as {name}_nominal."""
+    inv_q0 = F32(4.0) * k_e
+    kk = F32(2.0) / (q0 * q0 + nsq)
+    barrier = k.lam * detmath.logf(om)
+    fs = [shaping(k, x1[i]) for i in range(3)]
+    g = _v(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
+    w_ev = e_solve(q0, inv_q0, kk, x1, g)
+    x2 = _v(*(w_e[i] - w_ev[i] for i in range(3)))
+    x1_dot = e_apply(q0, x1, w_e)
+    q0_dot = F32(-0.5) * dot(x1, w_e)
+    e_dot_w = e_apply(q0_dot, x1_dot, w_ev)
+    radial = (k.nlam2 * dot(x1, x1_dot)) / om
+    dg = _v(*(((k.nbeta1 - k.beta2 * fs[i][1]) + barrier) * x1_dot[i] + radial * x1[i] for i in range(3)))
+    dg = _v(*(dg[i] - e_dot_w[i] for i in range(3)))
+    w_ev_dot = e_solve(q0, inv_q0, kk, x1, dg)
+    u = _v(*((k.nk1 * detmath.tanhf(k.eps1 * varpi[i]) - k.k2 * detmath.tanhf(k.eps2 * x1[i]))
+             - k.k3 * detmath.tanhf(k.eps3 * x1_dot[i]) for i in range(3)))
+    a = force_terms(k, re, w_c, w_e, wdot_t, w_ev_dot, u)
+    delta = _v(*(x2[i] - varpi[i] for i in range(3)))
+    dsq = dot(delta, delta)
+    inv_sq = F32(1.0) / np.where(dsq <= k.delta_reg, dsq + k.delta_reg, dsq)
+    along = ((((dot(x2, a) + dot(x1, x1_dot)) + k.k5) + k.d_max * detmath.sqrtf(dot(x2, x2))) * inv_sq) + k.k4
+    j_inv_a = mat_vec(tuple(k.J_inv), a)
+    ua = compensation(k, delta, dsq)
+    vdot = _v(*((j_inv_a[i] + along * delta[i]) + ua[i] for i in range(3)))
+    return u, vdot, x2
+
+
+_SKEW = ((7, 5), (2, 6), (3, 1))  # vee(R_e - R_eᵀ)_k = re[hi] - re[lo]
+
+
+def error_near_180(re, tr):
+    """The error quaternion's vector part by the largest-diagonal pivot, as {name}_error_near_180."""
+    k = np.where(re[4] > re[0], 1, 0)
+    k = np.where(re[8] > np.where(k == 1, re[4], re[0]), 2, k)
+    rkk = np.choose(k, (re[0], re[4], re[8]))
+    d = (F32(1.0) + F32(2.0) * rkk) - tr
+    ek = F32(0.5) * detmath.sqrtf(np.where(d > F32(0.0), d, F32(0.0)))
+    skew = np.choose(k, tuple(re[hi] - re[lo] for hi, lo in _SKEW))
+    ek = np.where(skew < F32(0.0), -ek, ek)
+    scale = F32(0.25) / ek
+    e = []
+    for j in range(3):
+        off = np.choose(k, tuple(re[3 * j + kk] + re[3 * kk + j] for kk in range(3))) * scale
+        e.append(np.where(ek == F32(0.0), F32(0.0), np.where(k == j, ek, off)))
+    return _v(*e)
+
+
+def fallback(k: Constants32, e, w_e):
+    return _v(*(k.nk2 * detmath.tanhf(k.eps2 * e[i]) - k.k3 * detmath.tanhf(k.eps3 * w_e[i]) for i in range(3)))
+
+
+def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
+    """(u, vdot, x1, x2, status, inputs_ok) as {name}_law; inputs_ok: R_e, w_e and wdot_t finite."""
+    re = error_matrix(rt, rc)
+    rw = mat_t_vec(re, w_t)
+    w_e = _v(*(w_c[i] - rw[i] for i in range(3)))
+    inputs_ok = np.all(np.isfinite(np.stack(re + w_e + wdot_t)), axis=0)
+    tr = (re[0] + re[4]) + re[8]
+    opt = F32(1.0) + tr
+    upper = opt > k.q0min_sq4
+    s = detmath.sqrtf(opt)
+    k_e = F32(0.5) / s
+    x1 = _v((re[7] - re[5]) * k_e, (re[2] - re[6]) * k_e, (re[3] - re[1]) * k_e)
+    nsq = dot(x1, x1)
+    om = np.where(upper, F32(1.0) - nsq, F32(0.0))
+    regular = om > k.q0min_sq
+    u_n, vdot_n, x2_n = nominal(k, varpi, re, F32(0.5) * s, k_e, x1, nsq, om, w_c, w_e, wdot_t)
+    e_s = error_near_180(re, tr)
+    u_s = fallback(k, e_s, w_e)
+    zero = np.zeros_like(tr)
+    pick = lambda a, b: _v(*(np.where(regular, a[i], b[i]) for i in range(3)))  # noqa: E731
+    status = np.where(regular, STATUS_OK, STATUS_SINGULAR).astype(np.uint32)
+    return (pick(u_n, u_s), pick(vdot_n, (zero, zero, zero)), pick(x1, e_s),
+            pick(x2_n, (zero, zero, zero)), status, inputs_ok)
+
+
+def _finite_rows(a: np.ndarray) -> np.ndarray:
+    return np.all(np.isfinite(a), axis=1)
+
+
+def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One {name}_step on N independent (state, input) rows: (new state (N, 3), output (N, 13))."""
+    state, inputs = _records(state, N_STATE, "state"), _records(inputs, N_IN, "inputs")
+    with np.errstate(all="ignore"):
+        state_ok = _finite_rows(state)
+        col = lambda a, j: np.ascontiguousarray(a[:, j])  # noqa: E731
+        vec = lambda name: tuple(col(inputs, j) for j in range(FIELDS[name].start, FIELDS[name].stop))  # noqa: E731
+        varpi = tuple(col(state, j) for j in range(3))
+        u, vdot, x1, x2, status, inputs_ok = law(k, varpi, vec("R_c"), vec("w_c"), vec("R_t"), vec("w_t"),
+                                                 vec("wdot_t"))
+        ok = state_ok & inputs_ok
+        zero = np.zeros(state.shape[0], dtype=F32)
+        result_ok = np.all(np.isfinite(np.stack(u + vdot)), axis=0)
+        keep = ok & result_ok
+        u = tuple(np.where(keep, c, zero) for c in u)
+        vdot = tuple(np.where(keep, c, zero) for c in vdot)
+        x1 = tuple(np.where(ok, c, zero) for c in x1)
+        x2 = tuple(np.where(ok, c, zero) for c in x2)
+        status = np.where(keep, status, np.uint32(STATUS_INVALID_INPUT)).astype(np.uint32)
+        varpi = tuple(np.where(state_ok, c, zero) for c in varpi)
+        new = []
+        for i in range(3):
+            v = _f32(varpi[i] + k.period * vdot[i], "euler")
+            new.append(np.where(v > k.limit, k.limit, np.where(v < -k.limit, -k.limit, v)))
+    new_state = np.stack(new, axis=1).astype(F32, copy=False)
+    out = np.empty((state.shape[0], N_OUT), dtype=F32)
+    for i in range(3):
+        out[:, i], out[:, 3 + i], out[:, 6 + i], out[:, 9 + i] = u[i], x1[i], x2[i], new_state[:, i]
+    out[:, 12] = status.view(F32)
+    return _f32(new_state, "state"), out
+
+
+def _records(a, n: int, what: str) -> np.ndarray:
+    a = np.asarray(a)
+    if a.dtype != F32 or a.ndim != 2 or a.shape[1] != n:
+        raise ValueError(f"golden_tanh: {what} must be float32 of shape (N, {n}), got {a.dtype} {a.shape}")
+    return a
+
+
+def run_sequences(k: Constants32, inputs: np.ndarray) -> np.ndarray:
+    """S independent time series from varpi = 0: inputs (S, T, 27) -> outputs (S, T, 13)."""
+    inputs = np.asarray(inputs)
+    if inputs.dtype != F32 or inputs.ndim != 3 or inputs.shape[2] != N_IN:
+        raise ValueError(f"golden_tanh: sequences must be float32 (S, T, {N_IN}), got {inputs.dtype} {inputs.shape}")
+    state = np.zeros((inputs.shape[0], N_STATE), dtype=F32)
+    out = np.empty(inputs.shape[:2] + (N_OUT,), dtype=F32)
+    for t in range(inputs.shape[1]):
+        state, out[:, t] = step(k, state, np.ascontiguousarray(inputs[:, t]))
+    return out

@@ -1,0 +1,123 @@
+"""C emitter of paper 000's tanh saturation law: parameters + control period -> `<name>.h/.c`.
+
+The parameters (codegen.tanh_params) are baked in as float32 hex-float constants; the float64
+values come from the same formulas as host.tanh_law.compile_constants and are rounded to
+float32 once, here, for both the C and the golden twin (codegen.golden_tanh reads
+`constants32`). Output is a pure function of (parameters, period, name, generator version):
+byte-identical sources for the same inputs. The deterministic math library is copied next to
+the law (codegen.emit.math_sources).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from codegen import GENERATOR_VERSION
+from codegen.emit import _environment, c_float, check_name, math_sources, write_sources
+from codegen.errors import CodegenError
+from codegen.tanh_params import TanhParams, derived_constants
+
+DEFAULT_NAME = "tanh"
+DEFAULT_PERIOD = 0.1  # s, the paper-000 example's sampled flight version
+
+
+@dataclass(frozen=True)
+class Constants32:
+    """Every float32 constant of the generated step, by template name (scalars and J, J_inv)."""
+
+    scalars: dict[str, np.float32]
+    J: np.ndarray       # (9,) float32, row-major
+    J_inv: np.ndarray   # (9,) float32, row-major
+
+    def __getattr__(self, name: str) -> np.float32:
+        try:
+            return self.scalars[name]
+        except KeyError:
+            raise AttributeError(name) from None
+
+
+def check_period(period: float) -> float:
+    if not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
+        raise CodegenError(f"control period must be a positive number of seconds, got {period!r}")
+    return float(period)
+
+
+def constants32(p: TanhParams, period: float) -> Constants32:
+    """The float64 constants of the law, each rounded to float32 once."""
+    period = check_period(period)
+    d = derived_constants(p)
+    values = {
+        "nk1": -p.k1, "nk2": -p.k2, "k2": p.k2, "k3": p.k3,
+        "eps1": p.eps1, "eps2": p.eps2, "eps3": p.eps3,
+        "nbeta1": -p.beta1, "beta2": p.beta2, "gamma": p.gamma, "eta": p.eta,
+        "r1": d["r1"], "r2": d["r2"], "r2x2": 2.0 * d["r2"],
+        "lam": p.lam, "nlam2": -2.0 * p.lam,
+        "k4": p.k4, "k5": p.k5, "d_max": p.d_max, "delta_reg": p.delta_reg, "n1": p.n1,
+        "ua_gain": d["ua_gain"], "ua_inner": d["ua_inner_scale"],
+        "q0min_sq": p.q0_min ** 2, "q0min_sq4": 4.0 * p.q0_min ** 2,
+        "period": period, "limit": p.varpi_limit,
+    }
+    with np.errstate(over="raise"):
+        try:
+            scalars = {k: np.float32(v) for k, v in values.items()}
+            J = np.asarray(d["J"], dtype=np.float32).reshape(9)
+            J_inv = np.asarray(d["J_inv"], dtype=np.float32).reshape(9)
+        except FloatingPointError:
+            raise CodegenError("a tanh-law constant overflows float32 (check the parameter magnitudes)") from None
+    return Constants32(scalars, J, J_inv)
+
+
+def params_sha256(p: TanhParams, period: float) -> str:
+    """sha256 of the canonical JSON of the parameter file form plus the period."""
+    payload = {"params": p.to_mapping(), "period": check_period(period)}
+    return hashlib.sha256(json.dumps(payload, sort_keys=True).encode("utf-8")).hexdigest()
+
+
+def _text(value: float) -> str:
+    return f"{value:.9g}"
+
+
+def template_context(p: TanhParams, period: float, name: str) -> dict:
+    c = constants32(p, period)
+    literal = {k: c_float(v) for k, v in c.scalars.items()}
+    literal["J"] = [c_float(v) for v in c.J]
+    literal["J_inv"] = [c_float(v) for v in c.J_inv]
+    items = [f"{k} = {_text(v)}" if not isinstance(v, list) else
+             f"{k} = {[[_text(x) for x in row] for row in v]}".replace("'", "")
+             for k, v in p.to_mapping().items()]
+    params_lines = [""]
+    for item in items:  # comment lines of at most ~90 characters
+        if params_lines[-1] and len(params_lines[-1]) + len(item) > 84:
+            params_lines.append("")
+        params_lines[-1] += (", " if params_lines[-1] else "") + item
+    return {
+        "name": name, "P": name.upper(), "c": literal,
+        "generator_version": GENERATOR_VERSION, "params_sha256": params_sha256(p, period),
+        "period": c_float(c.period), "period_text": _text(period),
+        "limit_text": _text(p.varpi_limit), "q0_min_text": _text(p.q0_min),
+        "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
+    }
+
+
+def tanh_sources(p: TanhParams, period: float = DEFAULT_PERIOD, name: str = DEFAULT_NAME) -> dict[str, str]:
+    """{file name: text}: `<name>.h`, `<name>.c` and the sg_math library they call."""
+    check_name(name)
+    env, ctx = _environment(), template_context(p, period, name)
+    sources = {
+        f"{name}.h": env.get_template("tanh.h.j2").render(ctx),
+        f"{name}.c": env.get_template("tanh.c.j2").render(ctx),
+    }
+    sources.update(math_sources())
+    return sources
+
+
+def emit_tanh(p: TanhParams, out_dir: str | os.PathLike, period: float = DEFAULT_PERIOD,
+              name: str = DEFAULT_NAME) -> list[Path]:
+    """Generate and write `<name>.h`, `<name>.c`, `sg_math.h`, `sg_math.c` into out_dir."""
+    return write_sources(tanh_sources(p, period, name), out_dir)

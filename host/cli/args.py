@@ -1,0 +1,30 @@
+"""Parsing of numeric command-line values into one-line HostErrors (shared by every subcommand)."""
+from __future__ import annotations
+
+import math
+
+from host.errors import HostError
+
+
+def parse_int(text: str, what: str, minimum: int = 0) -> int:
+    try:
+        value = int(text)
+    except (TypeError, ValueError):
+        raise HostError(f"{what} must be an integer, got {text!r}") from None
+    if value < minimum:
+        raise HostError(f"{what} must be at least {minimum}, got {value}")
+    return value
+
+
+def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise HostError(f"{what} must be a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise HostError(f"{what} must be finite, got {text!r}")
+    if positive and value <= 0:
+        raise HostError(f"{what} must be positive, got {text}")
+    if non_negative and value < 0:
+        raise HostError(f"{what} must not be negative, got {text}")
+    return value

@@ -1,0 +1,207 @@
+"""The generated controller: golden == x86 C == ARM C bit for bit on the whole step, time base
+accuracy, status bits, and a finite, limited torque for every input pattern."""
+import subprocess
+
+import numpy as np
+import pytest
+
+from codegen import controller_spec as cs
+from codegen import golden_controller as gc
+from codegen.controller_emit import INPUT_DTYPE, controller_sources, to_bam
+from firmware import arm
+from firmware.x86_controller import X86Controller
+from host import controller_gate as gate
+from host.constants import ARCSEC, DEG
+from host.nn_controller import flight_config, load_artifact
+from host.timebase import gmst
+
+N_STEPS = 4000
+N_SEQ, SEQ_STEPS = 3, 1000
+
+
+@pytest.fixture(autouse=True)
+def private_cache(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def artifact():
+    return load_artifact(None)
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    return flight_config()
+
+
+@pytest.fixture(scope="module")
+def vectors(cfg):
+    return gate.gate_inputs(N_STEPS, seed=11, dwell=cfg.dwell_steps)
+
+
+def test_three_way_gate_independent_steps(artifact, cfg, vectors):
+    states, inputs, kind = vectors
+    g_out, g_state = gc.step(artifact, cfg, states, inputs)
+    x_out, x_state = X86Controller(artifact, cfg).run_records(states, inputs)
+    a_out, a_state = gate.ArmRunner(artifact, cfg).run_records(states, inputs)
+    for out, st in ((x_out, x_state), (a_out, a_state)):
+        assert gate.compare_outputs(g_out, out) == []
+        assert gate.compare_states(g_state, st) == []
+        # uint32 patterns, NaN as a class, on the torque itself
+        assert np.array_equal(g_out["torque"].view(np.uint32), out["torque"].view(np.uint32))
+    # every class exercised both laws
+    pid = (g_out["status"] & cs.STATUS_PID) != 0
+    assert 0 < pid[kind == 0].mean() < 1
+    invalid = (g_out["status"] & cs.STATUS_INPUT_INVALID) != 0
+    assert invalid[kind == 2].mean() > 0.3 and pid[invalid].all() and not invalid[kind == 0].any()
+
+
+def test_three_way_gate_sequences_with_mode_switches(artifact, cfg):
+    seqs = gate.sequence_inputs(N_SEQ, SEQ_STEPS, seed=5)
+    g = gc.run_sequences(artifact, cfg, seqs)
+    switches = np.sum(np.diff((g["status"] & cs.STATUS_PID) != 0, axis=1))
+    assert switches >= 20
+    x86, arm_ = X86Controller(artifact, cfg), gate.ArmRunner(artifact, cfg)
+    for s in range(N_SEQ):
+        x86.reset()
+        assert gate.compare_outputs(g[s], x86.run_sequence(seqs[s])) == []
+        assert gate.compare_outputs(g[s], arm_.run_sequence(seqs[s])) == []
+
+
+def test_a_changed_operation_is_caught(artifact, cfg, vectors):
+    """The gate can fail: a controller built with another PID gain differs from the golden model."""
+    states, inputs, _ = vectors
+    other = cfg.__class__(**{**cfg.__dict__, "kd": (46.0, 77.0, 50.5)})
+    g_out, _ = gc.step(artifact, cfg, states, inputs)
+    x_out, _ = X86Controller(artifact, other).run_records(states, inputs)
+    assert gate.compare_outputs(g_out, x_out) != []
+
+
+def test_torque_finite_and_limited_for_special_values_in_every_field(artifact, cfg):
+    rng = np.random.default_rng(2)
+    base = gate.make_inputs(gate.random_geometry(rng, 1), np.zeros((1, 3)), np.zeros((1, 3)))
+    rows = []
+    for f in gate.FLOAT_FIELDS:
+        for i in range(3):
+            for v in gate.SPECIAL_F32:
+                r = base.copy()
+                r[f][0, i] = v
+                rows.append(r)
+    for f in ("utc_day", "utc_ms", "lon", "lat"):
+        for v in gate.INT_SPECIAL:
+            r = base.copy()
+            r[f] = np.int64(v).astype(np.int32) if f in ("lon", "lat") else np.clip(v, -2**31, 2**31 - 1)
+            rows.append(r)
+    bits = rng.integers(0, 2**32, (3000, INPUT_DTYPE.itemsize // 4), dtype=np.uint64).astype(np.uint32)
+    inputs = np.concatenate([*rows, bits.view(INPUT_DTYPE).reshape(-1)])
+    states = gate.random_states(rng, inputs.size, cfg.dwell_steps)
+    g_out, _ = gc.step(artifact, cfg, states, inputs)
+    x_out, _ = X86Controller(artifact, cfg).run_records(states, inputs)
+    assert gate.compare_outputs(g_out, x_out) == []
+    assert gate.torque_problems(x_out, cfg.torque_limit) == []
+    invalid = (x_out["status"][:len(rows)] & cs.STATUS_INPUT_INVALID) != 0
+    nonfinite = ~np.all(np.isfinite(np.stack([inputs[f][:len(rows)] for f in gate.FLOAT_FIELDS], 1).reshape(len(rows), -1)), 1)
+    assert np.all(invalid[nonfinite])
+
+
+def test_status_bits_name_the_crossed_bound(artifact, cfg):
+    rng = np.random.default_rng(4)
+    geo = gate.random_geometry(rng, 6)
+    A, w = np.zeros((6, 3)), np.zeros((6, 3))
+    for k in range(6):
+        (A if k < 3 else w)[k, k % 3] = (-1) ** k * (0.0202 if k < 3 else 0.00404) * DEG
+    out, _ = gc.step(artifact, cfg, gc.init(6), gate.make_inputs(geo, A, w))
+    for k in range(6):
+        assert out["status"][k] & cs.STATUS_BOUNDS_MASK == 1 << (cs.STATUS_BOUND_SHIFT + 6 + k)
+        assert out["status"][k] & cs.STATUS_PID
+
+
+def test_dwell_and_hand_back_in_the_c(artifact, cfg):
+    rng = np.random.default_rng(6)
+    geo = gate.random_geometry(rng, 1)
+    clean = gate.make_inputs(geo, np.zeros((1, 3)), np.zeros((1, 3)))
+    bad = gate.make_inputs(geo, np.array([[0.03 * DEG, 0, 0]]), np.zeros((1, 3)))
+    seq = np.concatenate([clean, bad, *([clean] * 12)])
+    c = X86Controller(artifact, cfg)
+    modes = (c.run_sequence(seq)["status"] & cs.STATUS_PID) != 0
+    assert modes.tolist() == [False, True] + [True] * 9 + [False] * 3
+
+
+def test_gmst_accurate_across_2000_2100():
+    """The controller's integer GMST vs host.timebase.gmst (float64 IAU-82): < 0.001 arcsec."""
+    rng = np.random.default_rng(0)
+    day = np.concatenate([[0, 36524], rng.integers(0, 36525, 20000)])
+    ms = np.concatenate([[0, 86_399_999], rng.integers(0, 86_400_000, 20000)])
+    turns = gc.gmst_turns(day, ms).astype(np.float64) / 2**32
+    ref = gmst(cs.J2000_JDN + day, ms / 1000.0) / (2 * np.pi)
+    err = (turns - ref + 0.5) % 1.0 - 0.5
+    assert np.max(np.abs(err)) * 2 * np.pi < 1e-3 * ARCSEC
+    # and the float32 sine and cosine the step uses: the angle they encode is within 0.025 arcsec
+    s, c = gc.sincos_turns(gc.gmst_turns(day, ms))
+    ang = np.arctan2(s.astype(np.float64), c.astype(np.float64))
+    d = (ang - ref * 2 * np.pi + np.pi) % (2 * np.pi) - np.pi
+    assert np.max(np.abs(d)) < 0.025 * ARCSEC
+
+
+def test_binary_angles_round_trip():
+    lon = np.array([-np.pi, -1.0, 0.0, 2.0943951023931953, np.pi - 1e-9, np.pi])
+    bam = to_bam(lon)
+    assert bam[0] == -2**31 and bam[-1] == -2**31 and bam[2] == 0
+    np.testing.assert_allclose(bam[1:5] * np.pi / 2**31, lon[1:5], atol=np.pi / 2**31)
+
+
+def test_arm_image_has_no_soft_double_and_no_libm(artifact, cfg):
+    from host.sil import controller_arm_build
+
+    build = controller_arm_build(artifact, cfg)
+    arm.check_symbols(build.elf)
+    names = subprocess.run([arm.tool(arm.ARM_NM), str(build.elf)], capture_output=True, text=True).stdout
+    assert "__aeabi_d" not in names and "__aeabi_f2d" not in names and "__aeabi_l" not in names
+    assert not build.newlib
+
+
+def test_golden_model_uses_no_numpy_math_and_no_reordering_sums():
+    import ast
+    import inspect
+
+    tree = ast.parse(inspect.getsource(gc))
+    used = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)}
+    banned = {"tanh", "sin", "cos", "exp", "log", "arctan2", "arcsin", "sqrt", "dot", "sum", "matmul", "einsum"}
+    assert not (used & banned), used & banned
+    assert not any(isinstance(n, ast.BinOp) and isinstance(n.op, ast.MatMult) for n in ast.walk(tree))
+
+
+def test_cffi_structs_match_the_record_layouts(artifact, cfg):
+    from codegen.controller_emit import OUTPUT_DTYPE, STATE_DTYPE
+
+    c = X86Controller(artifact, cfg)
+    assert c.ffi.sizeof("controller_input_t") == INPUT_DTYPE.itemsize == 64
+    assert c.ffi.sizeof("controller_output_t") == OUTPUT_DTYPE.itemsize == 40
+    assert c.ffi.sizeof("controller_state_t") == STATE_DTYPE.itemsize == 20
+
+
+def test_sources_are_deterministic_and_share_the_network_templates(artifact, cfg):
+    a, b = controller_sources(artifact, cfg), controller_sources(artifact, cfg)
+    assert a == b
+    assert set(a) == {"controller.h", "controller.c", "controller_nn.h", "controller_nn.c", "sg_math.h", "sg_math.c"}
+    assert "controller_nn_eval(x, cmd)" in a["controller.c"] and "double" not in a["controller.c"]
+
+
+def test_verify_and_cycles_commands(artifact, tmp_path, capsys):
+    import json
+
+    from host.cli import main
+
+    path = tmp_path / "a.json"
+    artifact.save(path)
+    assert main(["verify", "--artifact", str(path), "--target", "all", "--controller",
+                 "--vectors", "600", "--sequences", "1"]) == 0
+    assert "PASS" in capsys.readouterr().out
+    report = tmp_path / "c.json"
+    assert main(["cycles", "--entry", "controller", "--artifact", str(path), "--per-class", "4",
+                 "--json", str(report)]) == 0
+    rep = json.loads(report.read_text())["entries"]["controller"]
+    assert set(rep["by_class"]) == {"nn_path", "pid_path", "dwell", "invalid", "bits"}
+    # the PID path skips the network: far cheaper than the NN path
+    assert rep["by_class"]["pid_path"]["ideal"]["max"] < rep["by_class"]["nn_path"]["ideal"]["min"] - 2000
+    assert rep["stack_bytes"] <= 512 and rep["flash_bytes"] <= 24 * 1024

@@ -1,0 +1,240 @@
+"""Generated C of paper 000's tanh law: the three-way bit-exact gate (golden == x86 == ARM) over
+every vector class and closed-loop sequences with the state carried in the C, the gate's own
+sensitivity and coverage, the golden twin against the float64 host law, the generated text
+(SPEC section 5), the golden's SPEC section 6 rules, and parameter-file errors through the CLI."""
+import ast
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import host.cli as cli
+from codegen import bitcompare, tanh_emit
+from codegen import golden_tanh as gt
+from codegen.tanh_params import TanhParamsError, load_params
+from host import tanh_example as ex
+from host import tanh_gate, tanh_law
+from host.tanh_sil import ArmTanh, X86Tanh
+
+PARAMS = ex.paper_parameters()
+K = tanh_emit.constants32(PARAMS, 0.1)
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def builds():
+    return {"x86": X86Tanh(PARAMS), "arm": ArmTanh(PARAMS)}
+
+
+@pytest.fixture(scope="module")
+def vectors():
+    return tanh_gate.gate_vectors(PARAMS, 14_000, seed=7)
+
+
+@pytest.fixture(scope="module")
+def sequences():
+    return tanh_gate.closed_sequences(PARAMS, n_seq=3, steps=1000, seed=7)
+
+
+def assert_bits_equal(expected, actual):
+    result = bitcompare.compare(expected, actual)
+    assert result.ok, "\n".join(result.report("golden", "C"))
+
+
+# ----------------------------------------------------------------------------- the gate
+
+
+@pytest.mark.parametrize("target", ["x86", "arm"])
+def test_gate_every_class_bit_exact(builds, vectors, target):
+    for name, (state, x) in vectors.items():
+        _, golden = gt.step(K, state, x)
+        assert_bits_equal(golden, builds[target].step(state, x))
+
+
+@pytest.mark.parametrize("target", ["x86", "arm"])
+def test_closed_sequences_state_carried_in_c(builds, sequences, target):
+    inputs, golden = sequences
+    for s in range(inputs.shape[0]):
+        assert_bits_equal(golden[s], builds[target].sequence(inputs[s]))
+    # the golden replay from zero state equals the closed loop that produced the inputs
+    assert_bits_equal(gt.run_sequences(K, inputs).reshape(-1, gt.N_OUT), golden.reshape(-1, gt.N_OUT))
+
+
+def test_closed_sequences_converge_and_visit_the_fallback(sequences):
+    inputs, golden = sequences
+    status = golden[..., 12].view(np.uint32)
+    assert (status == gt.STATUS_SINGULAR).any() and (status == gt.STATUS_OK).any()
+    assert not (status == gt.STATUS_INVALID_INPUT).any()
+    assert np.all(np.abs(golden[..., 0:3]) <= 4.5)
+    assert np.all(np.linalg.norm(golden[:, -1, 3:6], axis=1) < 1e-2)  # converged after 100 s
+
+
+def test_gate_vectors_cover_every_branch(vectors):
+    state = np.concatenate([s for s, _ in vectors.values()])
+    x = np.concatenate([x for _, x in vectors.values()])
+    _, out = gt.step(K, state, x)
+    status = out[:, 12].view(np.uint32)
+    counts = np.bincount(status, minlength=3)
+    assert np.all(counts >= 500), counts
+    ok = status == gt.STATUS_OK
+    delta = (out[ok, 6:9].astype(np.float64) - state[ok])
+    dsq = np.sum(delta ** 2, axis=1)
+    assert (dsq <= PARAMS.n1 ** 2).sum() >= 200 and (dsq > PARAMS.n1 ** 2).sum() >= 200          # u_a branches
+    assert (dsq <= PARAMS.delta_reg).sum() >= 200 and (dsq > PARAMS.delta_reg).sum() >= 200      # ρ branches
+    x1 = np.abs(out[ok, 3:6])
+    assert (x1 <= PARAMS.eta).sum() >= 200 and (x1 > PARAMS.eta).sum() >= 200                    # f branches
+    assert (np.abs(out[:, 9:12]) == np.float32(PARAMS.varpi_limit)).any()                        # ϖ clamp
+    reset = ~np.all(np.isfinite(state), axis=1)
+    assert reset.sum() >= 50 and np.all(out[reset, 9:12] == 0) and np.all(status[reset] == 2)    # state reset
+    assert np.isnan(out).any()  # NaN outputs (x1/x2 of overflowing rows) are compared as a class
+
+
+def test_gate_other_parameters_and_period():
+    """Nothing is specific to the paper's numbers: γ, η, n1, J and the period all move."""
+    data = PARAMS.to_mapping()
+    data.update(gamma=0.55, eta=0.02, n1=0.05, k4=3.0, inertia=[[3.0, 0.1, 0.0], [0.1, 2.0, -0.2], [0.0, -0.2, 4.0]])
+    params = tanh_law.params_from_mapping(data)
+    k = tanh_emit.constants32(params, 0.05)
+    vectors = tanh_gate.gate_vectors(params, 3_500, seed=1, period=0.05)
+    for target in (X86Tanh(params, 0.05), ArmTanh(params, 0.05)):
+        for state, x in vectors.values():
+            assert_bits_equal(gt.step(k, state, x)[1], target.step(state, x))
+
+
+def test_gate_detects_a_one_ulp_change(builds, vectors):
+    state, x = vectors["random"]
+    scalars = dict(K.scalars)
+    scalars["k4"] = np.nextafter(scalars["k4"], np.float32(np.inf))
+    nudged = tanh_emit.Constants32(scalars, K.J, K.J_inv)
+    result = bitcompare.compare(gt.step(nudged, state, x)[1], builds["x86"].step(state, x))
+    assert not result.ok and result.n_mismatches > 100
+
+
+def test_gate_command_passes(capsys):
+    code = cli.main(["tanh", "gate", "--params", str(ROOT / "docs/tanh_paper000.toml"), "--vectors", "700",
+                     "--sequences", "1", "--steps", "50"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "PASS" in out and "sequence 0: arm vs golden: 0 mismatches" in out
+
+
+# ----------------------------------------------------------------------------- golden vs float64
+
+
+def test_golden_matches_the_float64_law():
+    """Away from the ρ switch (δᵀδ within 5 % of delta_reg) and 180°, float32 vs float64:
+    torque within 2e-3 N·m (tanh(50·) amplifies rounding ×75), the new ϖ within 1e-4 + 1e-3|ϖ|."""
+    rng = np.random.default_rng(3)
+    n = 3000
+    R_t = Rotation.random(n, random_state=rng).as_matrix()
+    # errors up to 115°: nearer 180° x1 = vee(R_e − R_eᵀ)/(2s) loses ~1e-7/q0² to the cancellation in
+    # s² = 1 + tr R_e (float32), which is the float32 resolution of the input, not an error of the C
+    rotvec = rng.normal(size=(n, 3))
+    rotvec *= (rng.uniform(0.0, 2.0, n) / np.linalg.norm(rotvec, axis=1))[:, None]
+    R_c = R_t @ Rotation.from_rotvec(rotvec).as_matrix()
+    w_c, w_t, wdot_t = rng.normal(scale=0.2, size=(n, 3)), rng.normal(scale=0.01, size=(n, 3)), np.zeros((n, 3))
+    varpi = rng.normal(scale=1.0, size=(n, 3)).astype(np.float32)
+    x = np.concatenate([R_c.reshape(n, 9), w_c, R_t.reshape(n, 9), w_t, wdot_t], axis=1).astype(np.float32)
+    new_state, out = gt.step(K, varpi, x)
+    C = tanh_law.compile_constants(PARAMS)
+    checked = 0
+    for i in range(n):
+        r = x[i].astype(float)
+        law = tanh_law.evaluate_law(C, tuple(varpi[i].astype(float)), tanh_law._as_mat(r[0:9].reshape(3, 3)),
+                                    tuple(r[9:12]), tanh_law._as_mat(r[12:21].reshape(3, 3)), tuple(r[21:24]),
+                                    tuple(r[24:27]))
+        dsq = sum((a - b) ** 2 for a, b in zip(law.x2, varpi[i].astype(float)))
+        if law.status != 0 or abs(dsq - PARAMS.delta_reg) < 0.05 * PARAMS.delta_reg:
+            continue
+        checked += 1
+        assert out[i, 12].view(np.uint32) == 0
+        np.testing.assert_allclose(out[i, 0:3], law.torque, atol=2e-3)
+        np.testing.assert_allclose(out[i, 3:6], law.x1, atol=1e-6)
+        v64 = tanh_law.euler_update(tuple(varpi[i].astype(float)), law.varpi_dot, 0.1, PARAMS.varpi_limit)
+        np.testing.assert_allclose(new_state[i], v64, atol=1e-4, rtol=1e-3)
+    assert checked > 0.9 * n
+
+
+# ----------------------------------------------------------------------------- generated text
+
+
+def test_generation_is_deterministic_and_documented():
+    a, b = tanh_emit.tanh_sources(PARAMS), tanh_emit.tanh_sources(ex.paper_parameters())
+    assert a == b and set(a) == {"tanh.h", "tanh.c", "sg_math.h", "sg_math.c"}
+    h, c = a["tanh.h"], a["tanh.c"]
+    sha = tanh_emit.params_sha256(PARAMS, 0.1)
+    assert sha in h and sha in c and tanh_emit.GENERATOR_VERSION in h
+    for needle in ("void tanh_init(tanh_state_t *state);", "tanh_input_t", "tanh_output_t", "N*m", "rad/s",
+                   "row-major", "TANH_STATUS_SINGULAR", "TANH_STATUS_INVALID_INPUT"):
+        assert needle in h
+    other = tanh_emit.tanh_sources(PARAMS, period=0.05)
+    assert other["tanh.c"] != c and "#define TANH_T (0x1.99999ap-5f)" in other["tanh.c"]
+
+
+def test_generated_c_follows_spec_5():
+    c = tanh_emit.tanh_sources(PARAMS)["tanh.c"]
+    code = re.sub(r"/\*.*?\*/", "", c, flags=re.S)
+    assert "double" not in code and "malloc" not in code and "<math.h>" not in code
+    assert not re.search(r"\b(tanhf?|expf?|logf?|powf?|sqrtf?)\s*\(", code)
+    # every floating literal is a hex float or carries the f suffix
+    for lit in re.findall(r"(?<![\w.])(\d+\.\d*(?:e[+-]?\d+)?f?|0x[0-9a-f.]+p[+-]?\d+f?)", code, flags=re.I):
+        assert lit.lower().endswith("f"), lit
+    # constants round-trip exactly: the literal is the float32 of constants32
+    assert f"#define TANH_K4 ({tanh_emit.c_float(K.k4)})" in code
+    # mutable state only through the caller's struct: file-scope objects are const
+    for line in code.splitlines():
+        if line.startswith("static") and "=" in line and "(" not in line.split("=")[0]:
+            assert "const" in line, line
+
+
+def test_golden_follows_spec_6():
+    tree = ast.parse(Path(gt.__file__).read_text())
+    banned = {"tanh", "exp", "log", "sin", "cos", "sqrt", "power", "dot", "sum", "matmul", "einsum", "cumsum",
+              "prod", "inner", "tensordot"}
+    used = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute) and isinstance(n.value, ast.Name)
+            and n.value.id == "np"}
+    assert not used & banned, used & banned
+    assert not any(isinstance(n, ast.BinOp) and isinstance(n.op, (ast.MatMult, ast.Pow)) for n in ast.walk(tree))
+    with pytest.raises(ValueError, match="float32"):
+        gt.step(K, np.zeros((1, 3)), np.zeros((1, 27), np.float32))
+
+
+def test_paper_parameter_file_is_the_example():
+    assert load_params(ROOT / "docs/tanh_paper000.toml") == PARAMS
+
+
+# ----------------------------------------------------------------------------- parameter-file errors
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda d: d.pop("k4"), "missing key 'k4'"),
+    (lambda d: d.update(k2=-1.5), "'k2' = -1.5 must be > 0"),
+    (lambda d: d.update(gamma=1.0), "'gamma' = 1.0 must be in (0, 1)"),
+    (lambda d: d.update(gamma=-0.2), "'gamma' = -0.2 must be in (0, 1)"),
+])
+@pytest.mark.parametrize("command", [["tanh", "codegen", "--out", "{out}"], ["cycles", "--entry", "tanh"],
+                                     ["tanh", "gate"]])
+def test_parameter_errors_are_one_line_through_the_cli(tmp_path, capsys, edit, message, command):
+    data = PARAMS.to_mapping()
+    edit(data)
+    path = tmp_path / "p.json"
+    path.write_text(json.dumps(data))
+    argv = [a.replace("{out}", str(tmp_path / "gen")) for a in command] + ["--params", str(path)]
+    code = cli.main(argv)
+    res = capsys.readouterr()
+    assert code == 2 and res.out == ""
+    assert res.err == f"staregen {command[0]}: error: {path}: {message}\n"
+    assert not (tmp_path / "gen").exists()
+
+
+def test_params_error_class_is_a_codegen_error():
+    from codegen.errors import CodegenError
+
+    assert issubclass(TanhParamsError, CodegenError)
+    with pytest.raises(CodegenError, match="control period"):
+        tanh_emit.constants32(PARAMS, -0.1)
+    assert math.isclose(float(K.period), 0.1, rel_tol=1e-7)

@@ -1,0 +1,83 @@
+"""The generated tanh-law C in the loop on the paper-000 example (0.1 s): SIL (x86 via cffi) and
+PIL (ARM ELF in the emulator) converge to the float64 steady state, agree with each other and
+with the golden twin bit for bit at every step, and track the float64 sampled run; the cycle
+report of tanh_step; `simulate --controller tanh-c|tanh-arm`."""
+import json
+
+import numpy as np
+import pytest
+
+import host.cli as cli
+from host import tanh_example as ex
+from host import tanh_sil
+
+PERIOD, DURATION, DT = 0.1, 40.0, 5e-4
+# Measured (docs/tanh-controller.md, "Generated C"): the C and float64 runs agree to 3.2e-7 in ‖e‖
+# until 13.2 s; in the final approach (13-17 s) the sampled loop amplifies any 1e-7 perturbation
+# (rounding R_c(0) to float32 alone moves the float64 run by 1.2e-3 there); after 25 s they agree
+# to 1.7e-8.
+AGREE_UNTIL_S = 12.0
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return ex.simulate_sampled(ex.paper_scenario(), PERIOD, DURATION, DT)
+
+
+@pytest.fixture(scope="module")
+def sil(reference):
+    return tanh_sil.run_in_loop("x86", PERIOD, DURATION, DT, reference=reference)
+
+
+@pytest.fixture(scope="module")
+def pil(reference):
+    return tanh_sil.run_in_loop("arm", PERIOD, DURATION, DT, reference=reference)
+
+
+@pytest.mark.parametrize("run", ["sil", "pil"])
+def test_c_in_the_loop_converges_to_the_float64_steady_state(request, reference, run):
+    m = request.getfixturevalue(run)
+    assert m["golden_mismatch_steps"] == 0 and m["control_steps"] == 401
+    assert m["t_settle"] is not None and m["t_settle"] <= 25.0
+    assert m["e_final"] <= 2e-5 and m["we_final"] <= 1e-5 and m["u_max"] <= 4.5
+    assert m["singular_samples"] == 0 and m["invalid_samples"] == 0 and m["finite"]
+    assert m["e_final"] == pytest.approx(m["e_final_float64"], rel=1e-2)
+    assert m["e_diff_after_25s"] <= 1e-6
+    t = m["history"]["t"]
+    diff = np.abs(np.linalg.norm(m["history"]["e"], axis=1) - np.linalg.norm(reference["e"], axis=1))
+    assert diff[t <= AGREE_UNTIL_S].max() <= 1e-6
+
+
+def test_sil_and_pil_fly_the_same_trajectory(sil, pil):
+    for key in ("e", "w_e", "u", "varpi", "x2", "status"):
+        np.testing.assert_array_equal(sil["history"][key], pil["history"][key])
+
+
+def test_pil_reports_cycles_per_step(pil):
+    cycles = pil["history"]["cycles"]
+    assert cycles.shape == (401,) and pil["cycles_min"] > 1000
+    # regression guard on the measured 1,665-2,117 (the SPEC budget of 1,500 is not met: see docs)
+    assert pil["cycles_max"] <= 2_300
+
+
+def test_cycle_report_of_tanh_step():
+    rep = tanh_sil.cycle_report(ex.paper_parameters(), per_class=12)
+    assert set(rep["by_class"]) == {"random", "small", "delta", "singular", "off_so3", "extreme", "special",
+                                    "example"}
+    assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
+    assert 0 < rep["flash_bytes"] <= 12 * 1024 and rep["ram_bytes"] == 0 and not rep["newlib"]
+    assert {"sg_tanhf", "sg_logf", "sg_expf", "tanh_step"} <= set(rep["functions"])
+    assert rep["functions"]["sg_tanhf"]["calls"]["max"] == 9
+    text = "\n".join(tanh_sil.cycle_text(rep))
+    assert "budget (SPEC 8), tanh law step worst case ideal" in text
+
+
+def test_simulate_cli_runs_the_c_in_the_loop(tmp_path, capsys):
+    out = tmp_path / "sim"
+    assert cli.main(["simulate", "--controller", "tanh-c", "--duration", "2", "--out", str(out)]) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["target"] == "x86" and metrics["period"] == 0.1 and metrics["golden_mismatch_steps"] == 0
+    for key in ("t_settle", "e_final", "we_final", "u_max", "e_diff_max"):
+        assert key in metrics
+    assert (out / "fig8_torque.png").read_bytes()[:4] == b"\x89PNG"
+    assert "golden_mismatch_steps" in capsys.readouterr().out
