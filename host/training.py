@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import artifact as art
-from codegen import golden
+from codegen import reference
 from host.baselines import LinearLS, SaturatedLinear
 from host.errors import HostError
 
@@ -482,7 +482,7 @@ def train_artifact(data, recipe: str | Recipe = "default", seed: int = 0, epochs
         train_mse_normalised=fit.train_mse_normalised, train_seconds=fit.train_seconds, choice=choice)
     # Metrics of what flies: the artifact's float32 weights (float64 arithmetic); filled in, then sealed.
     unsealed = export(fit, split)
-    report.net = error_metrics(split.Y_test, golden.reference_eval64(unsealed, split.X_test), split.output_map)
+    report.net = error_metrics(split.Y_test, reference.reference_eval64(unsealed, split.X_test), split.output_map)
     artifact = export(fit, split, report.metadata())
     report.total_seconds = time.perf_counter() - start
     return artifact, report

@@ -16,16 +16,7 @@ TG = central_target()
 DURATION = 100.0
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
-
-
-@pytest.fixture(scope="module")
-def artifact_file(tmp_path_factory):
-    path = tmp_path_factory.mktemp("artifact") / "standin.json"
-    load_artifact(None).save(path)
-    return str(path)
+pytestmark = pytest.mark.usefixtures("private_cache")
 
 
 def fly(name: str, artifact_file: str | None, duration: float = DURATION):

@@ -8,21 +8,11 @@ import pytest
 from host import impulse
 from host.cli import main
 from host.constants import DEG
-from host.nn_controller import load_artifact
 
 NN_BACK_WITHIN_S = 3.0
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
-
-
-@pytest.fixture(scope="module")
-def artifact_file(tmp_path_factory):
-    path = tmp_path_factory.mktemp("artifact") / "standin.json"
-    load_artifact(None).save(path)
-    return str(path)
+pytestmark = pytest.mark.usefixtures("private_cache")
 
 
 def test_impulse_torque_profile():

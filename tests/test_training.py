@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from codegen import artifact as art
+from codegen import reference
 from codegen import golden
 from host import sweep, training
 from host.baselines import LinearLS, SaturatedLinear, pd_ff_features
@@ -138,7 +139,7 @@ def test_train_artifact_metadata_metrics_and_same_bytes_for_the_same_seed():
     assert r1.n_test == 100 and np.isclose(r1.net["mse_eq24_sum_normalised"], 300 * r1.net["mse_mean_normalised"])
     # the reported errors are those of the exported float32 weights
     split = training.make_split(X, Y, seed=5)
-    direct = training.error_metrics(split.Y_test, golden.reference_eval64(a1, split.X_test), split.output_map)
+    direct = training.error_metrics(split.Y_test, reference.reference_eval64(a1, split.X_test), split.output_map)
     assert direct == r1.net
 
 

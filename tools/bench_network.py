@@ -28,6 +28,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from codegen import artifact as art  # noqa: E402
+from codegen import reference  # noqa: E402
 from codegen import golden  # noqa: E402
 from firmware import arm  # noqa: E402
 from host.cli.cycles import class_vectors  # noqa: E402
@@ -62,7 +63,7 @@ def _profile(elf: Path, entry: str, classes: dict[str, np.ndarray]):
 
 
 def _errors(a: art.Artifact, y: np.ndarray, x_inside: np.ndarray) -> tuple[float, float]:
-    err = np.abs(y.astype(np.float64) - golden.reference_eval64(a, x_inside))
+    err = np.abs(y.astype(np.float64) - reference.reference_eval64(a, x_inside))
     span = (a.output_map.xmax - a.output_map.xmin).astype(np.float64)
     return float(err.max()), float((err / span).max())
 

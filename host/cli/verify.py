@@ -13,6 +13,7 @@ import time
 import numpy as np
 
 from codegen import artifact as art
+from codegen import reference
 from codegen import bitcompare, golden, vectors
 from host.cli.c_eval import EVALUATORS, evaluator
 from host.errors import HostError
@@ -46,7 +47,7 @@ def reference_error(a: art.Artifact, vs: vectors.VectorSet, y_golden: np.ndarray
     inside = vectors.inside_mask(a.envelope, vs.x)
     if not inside.any():
         return ["golden vs float64 reference: no in-envelope vectors"]
-    ref = golden.reference_eval64(a, vs.x[inside])
+    ref = reference.reference_eval64(a, vs.x[inside])
     err = np.abs(y_golden[inside].astype(np.float64) - ref).max(axis=0)
     span = a.output_map.xmax - a.output_map.xmin
     rel = err / np.where(span > 0, span, 1.0)
