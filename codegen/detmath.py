@@ -316,3 +316,46 @@ def powf_pos(x, y) -> np.ndarray:
         r = np.where((y == F32(0.0)) | (x == F32(1.0)), F32(1.0),
                      np.where(x < F32(0.0), _NAN, r))
     return _check(r)
+
+
+# ---------------------------------------------------------------- fused power (sg_powf_fused)
+
+_PF_LOG2 = tuple(float.fromhex(h) for h in (
+    "-0x1.2a5f1ap-3", "0x1.e50a6ap-3", "-0x1.0011d6p-2", "0x1.25992ap-2",
+    "-0x1.70baf6p-2", "0x1.ec7b3ep-2", "-0x1.7155b8p-1", "0x1.715472p+0"))  # c7 .. c0
+_PF_EXP2 = tuple(float.fromhex(h) for h in (
+    "0x1.417a9cp-13", "0x1.5f0948p-10", "0x1.3b2dd2p-7", "0x1.c6af7ap-5",
+    "0x1.ebfbdcp-3", "0x1.62e43p-1"))  # e5 .. e0
+#: |y log2 x| below which sg_powf_fused takes its fast path (the result is then normal).
+POWF_FUSED_MAX_T = F32(125.0)
+#: Published bound of sg_powf_fused on its fast path (measured in docs/math.md, asserted by tests):
+#: error <= POWF_FUSED_ULP_BASE + POWF_FUSED_ULP_PER_Y * |y| ulp (the log2 polynomial's error is
+#: scaled by y; it does not grow with |y log2 x| as powf_pos's does).
+POWF_FUSED_ULP_BASE = 1.2
+POWF_FUSED_ULP_PER_Y = 1.0
+
+
+def powf_fused(x, y) -> np.ndarray:
+    """Mirror of sg_powf_fused (sg_math.h): x^y = 2^(y log2 x) in one pass for x positive normal
+    and |y log2 x| < 125; otherwise powf_pos(x, y)."""
+    x, y = np.broadcast_arrays(_f32(x), _f32(y))
+    with np.errstate(all="ignore"):
+        bx = _as_u32(x)
+        fast = (bx - U32(0x00800000)) < U32(0x7F000000)
+        ix = bx + U32(0x3F800000 - 0x3F3504F3)
+        kf = ((ix >> U32(23)).astype(np.int32) - np.int32(127)).astype(F32)
+        f = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F3504F3)) - F32(1.0)
+        lm = f * _horner(f, _PF_LOG2)
+        yh = _as_f32(_as_u32(y) & U32(0xFFFFF000))
+        yl = y - yh
+        th = yh * kf
+        tl = yl * kf + y * lm
+        t = th + tl
+        fast = fast & (np.abs(t) < POWF_FUSED_MAX_T)
+        bt = t + _MAGIC
+        nf = bt - _MAGIC
+        r = (th - nf) + tl
+        p = F32(1.0) + r * _horner(r, _PF_EXP2)
+        res = _as_f32(_as_u32(p) + (_as_u32(bt) << U32(23)))
+        out = np.where(fast, res, powf_pos(x, y))
+    return _check(out)

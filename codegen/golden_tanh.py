@@ -4,9 +4,10 @@ Operation for operation and in the same order as the C, vectorised across N inde
 states: a 3-vector is a tuple of three (N,) float32 arrays, R_e nine of them; every C branch
 is a mask (np.where), both sides computed, the taken one kept. Sums are written out left to
 right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin): tanhf,
-logf, expf, sqrtf; |x|^γ = expf(γ·logf|x|) as in the C. Constants are the float32 values of
-codegen.tanh_emit.constants32, the same ones the C carries as hex floats. Every stage
-asserts float32 (numpy 2 promotes float32 with a float64 scalar).
+logf, sqrtf, powf_fused; |x|^γ = |x|·powf_fused(|x|, γ−1) in f (11), powf_fused(|x|, γ) in
+u_a (20), as in the C. Constants are the float32 values of codegen.tanh_emit.constants32, the
+same ones the C carries as hex floats. Every stage asserts float32 (numpy 2 promotes float32
+with a float64 scalar).
 
 Records use the C struct layouts: input (N, 27) = R_c[9], w_c[3], R_t[9], w_t[3], wdot_t[3];
 state (N, 3) = varpi; output (N, 13) = torque[3], x1[3], x2[3], varpi[3], status (uint32 bits,
@@ -79,14 +80,15 @@ def shaping(k: Constants32, x):
     """(f(x), f'(x)) of eq. 11 as the C computes them."""
     ax = np.abs(x)
     inside = ax <= k.eta
-    p = detmath.expf(k.gamma * detmath.logf(ax))
+    q = detmath.powf_fused(ax, k.gamma_m1)  # |x|^(γ-1): f = sign(x)|x|q, f' = γq (no division)
+    p = ax * q
     f = np.where(inside, k.r1 * x + (k.r2 * x) * ax, np.where(x < F32(0.0), -p, p))
-    slope = np.where(inside, k.r1 + k.r2x2 * ax, (k.gamma * p) / ax)
+    slope = np.where(inside, k.r1 + k.r2x2 * ax, k.gamma * q)
     return _f32(f, "shaping"), _f32(slope, "shaping slope")
 
 
 def sig_pow(k: Constants32, d):
-    p = detmath.expf(k.gamma * detmath.logf(np.abs(d)))
+    p = detmath.powf_fused(np.abs(d), k.gamma)
     return _f32(np.where(d < F32(0.0), -p, p), "sig_pow")
 
 

@@ -55,7 +55,7 @@ def constants32(p: TanhParams, period: float) -> Constants32:
     values = {
         "nk1": -p.k1, "nk2": -p.k2, "k2": p.k2, "k3": p.k3,
         "eps1": p.eps1, "eps2": p.eps2, "eps3": p.eps3,
-        "nbeta1": -p.beta1, "beta2": p.beta2, "gamma": p.gamma, "eta": p.eta,
+        "nbeta1": -p.beta1, "beta2": p.beta2, "gamma": p.gamma, "gamma_m1": p.gamma - 1.0, "eta": p.eta,
         "r1": d["r1"], "r2": d["r2"], "r2x2": 2.0 * d["r2"],
         "lam": p.lam, "nlam2": -2.0 * p.lam,
         "k4": p.k4, "k5": p.k5, "d_max": p.d_max, "delta_reg": p.delta_reg, "n1": p.n1,

@@ -32,7 +32,13 @@ WRAPPERS = "\n".join(
     + [f"void batch_{n}(const float *a, const float *b, float *y, int n) {{ for (int i = 0; "
        f"i < n; i++) y[i] = sg_{n}(a[i], b[i]); }}" for n in BINARY]
     + ["void batch_inline_tanhf(const float *x, float *y, int n) { for (int i = 0; i < n; i++) "
-       "y[i] = sg_inline_tanhf(x[i]); }"])
+       "y[i] = sg_inline_tanhf(x[i]); }",
+       "void batch_inline_tanhf_full(const float *x, float *y, int n) { for (int i = 0; i < n; i++) "
+       "y[i] = sg_inline_tanhf_full(x[i]); }",
+       "void batch_powf_fused(const float *a, const float *b, float *y, int n) { for (int i = 0; "
+       "i < n; i++) y[i] = sg_powf_fused(a[i], b[i]); }",
+       "void batch_powf_fused_08(const float *a, float *y, int n) { for (int i = 0; i < n; i++) "
+       "y[i] = sg_powf_fused(a[i], 0x1.99999ap-1f); }"])
 
 
 OPT_LEVELS = ["-O2", "-O0", "-Os"]  # the flight level and the benchmark levels (with_opt)
@@ -48,9 +54,10 @@ def clib(request, tmp_path_factory):
     subprocess.run(["gcc", *with_opt(COMMON, request.param), "-fPIC", "-shared", "-I", str(CSRC),
                     str(CSRC / "sg_math.c"), str(d / "wrap.c"), "-o", str(so)], check=True)
     ffi = cffi.FFI()
-    ffi.cdef("\n".join([f"void batch_{n}(const float *, float *, int);" for n in [*UNARY, "inline_tanhf"]]
+    ffi.cdef("\n".join([f"void batch_{n}(const float *, float *, int);"
+                        for n in [*UNARY, "inline_tanhf", "inline_tanhf_full", "powf_fused_08"]]
                        + [f"void batch_{n}(const float *, const float *, float *, int);"
-                          for n in BINARY]))
+                          for n in [*BINARY, "powf_fused"]]))
     lib = ffi.dlopen(str(so))
 
     def call(name: str, *args: np.ndarray) -> np.ndarray:
@@ -110,6 +117,17 @@ def test_inline_tanh_is_sg_tanhf_bit_for_bit(clib):
     x = np.concatenate([unary_inputs("tanhf", rng), SPECIALS, -SPECIALS,
                         rng.integers(0, 2**32, 60_000, dtype=np.uint64).astype(np.uint32).view(F32)])
     a, b = clib("inline_tanhf", x), clib("tanhf", x)
+    assert np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def test_inline_tanh_full_is_sg_tanhf_bit_for_bit(clib):
+    """sg_inline_tanhf_full (sg_math.h, the tanh law's torque: out-of-range arguments inline too)
+    and sg_tanhf give the same bits, NaN payloads included, at each optimisation level."""
+    rng = np.random.default_rng(8)
+    near9 = bits((np.int64(0x41100000) + np.arange(-50, 51)).astype(np.uint32))
+    x = np.concatenate([unary_inputs("tanhf", rng), SPECIALS, -SPECIALS, near9, -near9,
+                        rng.integers(0, 2**32, 60_000, dtype=np.uint64).astype(np.uint32).view(F32)])
+    a, b = clib("inline_tanhf_full", x), clib("tanhf", x)
     assert np.array_equal(a.view(np.uint32), b.view(np.uint32))
 
 
@@ -329,7 +347,7 @@ def test_arm_object_has_no_libm_or_soft_double(tmp_path, opt):
     assert {f"sg_{n}" for n in UNARY + BINARY} <= defined
 
 
-def _arm_runner(tmp_path):
+def _arm_runner(tmp_path, extra: list[str] | None = None):
     """Link sg_math.c for the Cortex-M4F at 0x08000000 and return call(name, *uint32 arrays)
     that runs one function per argument set in Unicorn (Cortex-M4 model, FZ = 0)."""
     from elftools.elf.elffile import ELFFile
@@ -338,8 +356,8 @@ def _arm_runner(tmp_path):
 
     elf = tmp_path / "sg_math.elf"
     subprocess.run([ARM_CC, *COMMON, *ARM_CPU, "-nostdlib", "-nostartfiles",
-                    "-Wl,-Ttext=0x08000000", "-Wl,-e,sg_tanhf", str(CSRC / "sg_math.c"),
-                    "-o", str(elf)], check=True)
+                    "-Wl,-Ttext=0x08000000", "-Wl,-e,sg_tanhf", "-I", str(CSRC), str(CSRC / "sg_math.c"),
+                    *(extra or []), "-o", str(elf)], check=True)
     mu = Uc(UC_ARCH_ARM, UC_MODE_THUMB | UC_MODE_MCLASS)
     mu.ctl_set_cpu_model(a.UC_CPU_ARM_CORTEX_M4)
     for base, size in ((0x08000000, 0x100000), (0x20000000, 0x20000), (0x0FFFF000, 0x1000)):
@@ -382,3 +400,88 @@ def test_arm_emulated_equals_twin(tmp_path):
         y_arm = call(name, p.view(np.uint32), q.view(np.uint32))
         bad = ~same(getattr(dm, name)(p, q), y_arm)
         assert not bad.any(), (name, p[bad][:5], q[bad][:5])
+
+
+# ---------------------------------------------------------------- sg_powf_fused (sg_math.h)
+
+def powf_fused_inputs(rng: np.random.Generator, n: int = 120_000) -> tuple[np.ndarray, np.ndarray]:
+    """Fast-path pairs (x log-uniform over the positive normals, y in [-4, 4] scaled so that
+    |y log2 x| < 125 mostly, and y = 0.8 on (1e-8, 1]), then special pairs and random bits."""
+    x = np.exp2(rng.uniform(-126, 128, n)).astype(F32)
+    y = (rng.uniform(-4, 4, n) * np.minimum(1.0, 124.0 / np.maximum(np.abs(np.log2(x.astype(np.float64))), 1.0)))
+    x2 = np.exp2(rng.uniform(-26.6, 0, n // 2)).astype(F32)
+    grid = np.concatenate([SPECIALS, -SPECIALS, F32([0.8, 0.5, 2.0, -1.0, 125.0, 1e-30])])
+    ga, gb = (g.ravel() for g in np.meshgrid(grid, grid))
+    rx = rng.integers(0, 2**32, 20_000, dtype=np.uint64).astype(np.uint32).view(F32)
+    ry = rng.integers(0, 2**32, 20_000, dtype=np.uint64).astype(np.uint32).view(F32)
+    return (np.concatenate([x, x2, ga, rx, np.abs(rx)]),
+            np.concatenate([y.astype(F32), np.full(x2.size, F32(0.8)), gb, ry, rng.uniform(-2, 2, 20_000).astype(F32)]))
+
+
+def test_powf_fused_twin_equals_c(clib):
+    """sg_powf_fused == detmath.powf_fused bit for bit on >= 1e5 fast-path pairs, every special
+    pair and random bit patterns, at each optimisation level; also with a constant y (0.8) as
+    the generated tanh law calls it (the y split is then folded by the compiler)."""
+    x, y = powf_fused_inputs(np.random.default_rng(21))
+    assert x.size >= 100_000
+    y_twin, y_c = dm.powf_fused(x, y), clib("powf_fused", x, y)
+    bad = ~same(y_twin, y_c)
+    assert not bad.any(), (x[bad][:5], y[bad][:5], y_twin[bad][:5], y_c[bad][:5])
+    x8 = np.concatenate([np.abs(x), x])
+    bad = ~same(dm.powf_fused(x8, F32(0.8)), clib("powf_fused_08", x8))
+    assert not bad.any(), x8[bad][:5]
+
+
+def test_powf_fused_sampled_ulp_bound():
+    """Fast path: error <= POWF_FUSED_ULP_BASE + POWF_FUSED_ULP_PER_Y |y| ulp on 1.2e6 samples
+    (docs/math.md); y = 0.8 (the tanh law's gamma) within 1.7 ulp on (1e-8, 1e4]."""
+    rng = np.random.default_rng(22)
+    x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
+    y = (rng.uniform(-4, 4, x.size) * np.minimum(1.0, 120.0 / np.maximum(np.abs(np.log2(x.astype(np.float64))), 1.0)))
+    y = y.astype(F32)
+    with np.errstate(all="ignore"):
+        t = y.astype(np.float64) * np.log2(x.astype(np.float64))
+    ok = np.abs(t) < 124.0
+    x, y = x[ok], y[ok]
+    ref = np.power(x.astype(np.float64), y.astype(np.float64))
+    err = ulp_error(dm.powf_fused(x, y), ref)
+    bound = dm.POWF_FUSED_ULP_BASE + dm.POWF_FUSED_ULP_PER_Y * np.abs(y.astype(np.float64))
+    assert (err <= bound).all(), (err[err > bound][:3], x[err > bound][:3], y[err > bound][:3])
+    g = F32(0.8)
+    x = np.exp(rng.uniform(np.log(1e-8), np.log(1e4), 200_000)).astype(F32)
+    err = ulp_error(dm.powf_fused(x, g), np.power(x.astype(np.float64), float(g)))
+    assert err.max() <= 1.7, err.max()
+
+
+EDGES_POW_FUSED = [(0.0, 0.8, 0.0), (-0.0, 0.8, 0.0), (1.0, 0.8, 1.0), (1.0, -3.0, 1.0),
+                   (2.0, 0.0, 1.0), (4.0, 0.5, 2.0), (0.25, 0.5, 0.5), (8.0, -1.0, 0.125),
+                   (-2.0, 0.8, np.nan), (np.inf, 0.8, np.inf), (np.nan, 0.8, np.nan),
+                   (2.0, np.nan, np.nan), (2.0**-130, 0.8, None), (2.0, 200.0, np.inf)]
+
+
+@pytest.mark.parametrize("x,y,want", EDGES_POW_FUSED)
+def test_edge_cases_powf_fused(clib, x, y, want):
+    """Special values (through sg_powf_pos) and exact powers of two on the fast path."""
+    got_twin = dm.powf_fused(x, y)
+    got_c = clib("powf_fused", np.array([x], F32), np.array([y], F32))[0]
+    assert same(np.asarray(got_twin, F32), np.asarray(got_c, F32))
+    if want is None:  # subnormal x: the sg_powf_pos path
+        assert same(np.asarray(got_twin, F32), dm.powf_pos(x, y))
+    else:
+        assert same(np.asarray(got_twin, F32), np.asarray(want, F32)), (x, y, got_twin, want)
+
+
+def test_arm_emulated_powf_fused_equals_twin(tmp_path):
+    """The Cortex-M4F build of sg_powf_fused (through an out-of-line wrapper) gives the twin's bits."""
+    wrap = tmp_path / "powf_fused_wrap.c"
+    wrap.write_text('#include "sg_math.h"\nfloat sg_powf_fused_call(float x, float y);\n'
+                    "float sg_powf_fused_call(float x, float y) { return sg_powf_fused(x, y); }\n")
+    call = _arm_runner(tmp_path, extra=[str(wrap)])
+    rng = np.random.default_rng(23)
+    x, y = powf_fused_inputs(rng, 2_000)
+    i = rng.choice(x.size, 4_000, replace=False)
+    x = np.concatenate([x[:3_000], x[i]])
+    y = np.concatenate([y[:3_000], y[i]])
+    y_arm = call("powf_fused_call", x.view(np.uint32), y.view(np.uint32))
+    bad = ~same(dm.powf_fused(x, y), y_arm)
+    assert not bad.any(), (x[bad][:5], y[bad][:5])

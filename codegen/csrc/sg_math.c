@@ -490,6 +490,16 @@ float sg_sqrtf(float x)
 }
 
 /* x^y = e^{y ln x} for x >= 0 (see sg_math.h for the special cases). */
+/* Coefficients of sg_powf_fused (sg_math.h): log2(1+f)/f on [sqrt(1/2) - 1, sqrt(2) - 1] (degree 7,
+ * absolute error of f P(f) 4.9e-8) and (2^r - 1)/r on [-1/2, 1/2] (degree 5, relative error of
+ * 1 + r Q(r) 3.0e-9), float32 minimax fits rounded low order first. */
+const float sg_powf_fused_tab[14] = {
+    -0x1.2a5f1ap-3f, 0x1.e50a6ap-3f, -0x1.0011d6p-2f, 0x1.25992ap-2f,
+    -0x1.70baf6p-2f, 0x1.ec7b3ep-2f, -0x1.7155b8p-1f, 0x1.715472p+0f,
+    0x1.417a9cp-13f, 0x1.5f0948p-10f, 0x1.3b2dd2p-7f, 0x1.c6af7ap-5f,
+    0x1.ebfbdcp-3f, 0x1.62e43p-1f
+};
+
 float sg_powf_pos(float x, float y)
 {
     if (y == 0.0f || x == 1.0f) {
