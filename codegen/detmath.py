@@ -13,7 +13,11 @@ the IEEE special values themselves) legitimately produce inf/nan intermediates.
 
 from __future__ import annotations
 
+import decimal
+import functools
+import math
 import re
+from typing import NamedTuple
 from pathlib import Path
 
 import numpy as np
@@ -359,3 +363,218 @@ def powf_fused(x, y) -> np.ndarray:
         res = _as_f32(_as_u32(p) + (_as_u32(bt) << U32(23)))
         out = np.where(fast, res, powf_pos(x, y))
     return _check(out)
+
+
+# ---------------------------------------------------------------- powf_tab (sg_math.h)
+
+_PT_LOG = np.array([
+    (float.fromhex("0x1.6ap-1"), float.fromhex("0x1.6a13cep+0"), float.fromhex("-0x1.001434p-1")),
+    (float.fromhex("0x1.72p-1"), float.fromhex("0x1.623fa8p+0"), float.fromhex("-0x1.dfdd8ap-2")),
+    (float.fromhex("0x1.7ap-1"), float.fromhex("0x1.5ac056p+0"), float.fromhex("-0x1.c04386p-2")),
+    (float.fromhex("0x1.82p-1"), float.fromhex("0x1.539094p+0"), float.fromhex("-0x1.a152f2p-2")),
+    (float.fromhex("0x1.8ap-1"), float.fromhex("0x1.4cab88p+0"), float.fromhex("-0x1.8304dap-2")),
+    (float.fromhex("0x1.92p-1"), float.fromhex("0x1.460cbcp+0"), float.fromhex("-0x1.6552b4p-2")),
+    (float.fromhex("0x1.9ap-1"), float.fromhex("0x1.3fb014p+0"), float.fromhex("-0x1.48365ep-2")),
+    (float.fromhex("0x1.a2p-1"), float.fromhex("0x1.3991c2p+0"), float.fromhex("-0x1.2baa0cp-2")),
+    (float.fromhex("0x1.aap-1"), float.fromhex("0x1.33ae46p+0"), float.fromhex("-0x1.0fa848p-2")),
+    (float.fromhex("0x1.b2p-1"), float.fromhex("0x1.2e025cp+0"), float.fromhex("-0x1.e857d4p-3")),
+    (float.fromhex("0x1.bap-1"), float.fromhex("0x1.288b02p+0"), float.fromhex("-0x1.b26024p-3")),
+    (float.fromhex("0x1.c2p-1"), float.fromhex("0x1.234568p+0"), float.fromhex("-0x1.7d604ap-3")),
+    (float.fromhex("0x1.cap-1"), float.fromhex("0x1.1e2ef4p+0"), float.fromhex("-0x1.494f86p-3")),
+    (float.fromhex("0x1.d2p-1"), float.fromhex("0x1.194538p+0"), float.fromhex("-0x1.162594p-3")),
+    (float.fromhex("0x1.dap-1"), float.fromhex("0x1.1485fp+0"), float.fromhex("-0x1.c7b528p-4")),
+    (float.fromhex("0x1.e2p-1"), float.fromhex("0x1.0fef02p+0"), float.fromhex("-0x1.64ce26p-4")),
+    (float.fromhex("0x1.eap-1"), float.fromhex("0x1.0b7e6ep+0"), float.fromhex("-0x1.0387fp-4")),
+    (float.fromhex("0x1.f2p-1"), float.fromhex("0x1.07326p+0"), float.fromhex("-0x1.47aa08p-5")),
+    (float.fromhex("0x1.fap-1"), float.fromhex("0x1.03091cp+0"), float.fromhex("-0x1.16a21ep-6")),
+    (float.fromhex("0x1.028p+0"), float.fromhex("0x1.fb0c62p-1"), float.fromhex("0x1.cb6c3ap-7")),
+    (float.fromhex("0x1.0ap+0"), float.fromhex("0x1.ecc07cp-1"), float.fromhex("0x1.c4dfacp-5")),
+    (float.fromhex("0x1.12p+0"), float.fromhex("0x1.de5d6ep-1"), float.fromhex("0x1.918a16p-4")),
+    (float.fromhex("0x1.1ap+0"), float.fromhex("0x1.d0cb58p-1"), float.fromhex("0x1.1dcd1ap-3")),
+    (float.fromhex("0x1.22p+0"), float.fromhex("0x1.c3f8fp-1"), float.fromhex("0x1.70742ep-3")),
+    (float.fromhex("0x1.2ap+0"), float.fromhex("0x1.b7d6c4p-1"), float.fromhex("0x1.c0db6cp-3")),
+    (float.fromhex("0x1.32p+0"), float.fromhex("0x1.ac5702p-1"), float.fromhex("0x1.0790aep-2")),
+    (float.fromhex("0x1.3ap+0"), float.fromhex("0x1.a16d4p-1"), float.fromhex("0x1.2db11p-2")),
+    (float.fromhex("0x1.42p+0"), float.fromhex("0x1.970e5p-1"), float.fromhex("0x1.52dbep-2")),
+    (float.fromhex("0x1.4ap+0"), float.fromhex("0x1.8d3018p-1"), float.fromhex("0x1.771d2cp-2")),
+    (float.fromhex("0x1.52p+0"), float.fromhex("0x1.83c978p-1"), float.fromhex("0x1.9a8024p-2")),
+    (float.fromhex("0x1.5ap+0"), float.fromhex("0x1.7ad22p-1"), float.fromhex("0x1.bd0f2ep-2")),
+    (float.fromhex("0x1.62p+0"), float.fromhex("0x1.724288p-1"), float.fromhex("0x1.ded3fep-2")),
+], dtype=F32)
+_PT_A = tuple(F32(v) for v in (float.fromhex("0x1.715476p+0"), float.fromhex("-0x1.715daep-1"), float.fromhex("0x1.ec89cap-2")))  # a0, a1, a2
+_PT_B = tuple(F32(v) for v in (float.fromhex("0x1.62e43p-6"), float.fromhex("0x1.ebfce6p-13"), float.fromhex("0x1.c6b186p-20")))  # b0, b1, b2
+_PT_EXP2 = np.array([0x3f800000, 0x3f82cd87, 0x3f85aac3, 0x3f88980f, 0x3f8b95c2, 0x3f8ea43a, 0x3f91c3d3, 0x3f94f4f0, 0x3f9837f0, 0x3f9b8d3a, 0x3f9ef532, 0x3fa27043, 0x3fa5fed7, 0x3fa9a15b, 0x3fad583f, 0x3fb123f6, 0x3fb504f3, 0x3fb8fbaf, 0x3fbd08a4, 0x3fc12c4d, 0x3fc5672a, 0x3fc9b9be, 0x3fce248c, 0x3fd2a81e, 0x3fd744fd, 0x3fdbfbb8, 0x3fe0ccdf, 0x3fe5b907, 0x3feac0c7, 0x3fefe4ba, 0x3ff5257d, 0x3ffa83b3], dtype=np.uint32)
+#: powf_tab fast path: error <= POWF_TAB_ULP_BASE + POWF_TAB_ULP_PER_Y * |y| ulp (sampled,
+#: tests/test_detmath.py; docs/math.md).
+POWF_TAB_ULP_BASE = 1.2
+POWF_TAB_ULP_PER_Y = 1.0
+
+
+def powf_tab(x, y) -> np.ndarray:
+    """Mirror of sg_powf_tab (sg_math.h): table-driven 2^(y log2 x) for x positive normal and
+    |y log2 x| < 125; otherwise powf_pos(x, y)."""
+    x, y = np.broadcast_arrays(_f32(x), _f32(y))
+    with np.errstate(all="ignore"):
+        bx = _as_u32(x)
+        fast = (bx - U32(0x00800000)) < U32(0x7F000000)
+        ix = bx + U32(0x3F800000 - 0x3F330000)
+        kf = ((ix >> U32(23)).astype(np.int32) - np.int32(127)).astype(F32)
+        row = _PT_LOG[((ix >> U32(18)) & U32(31)).astype(np.intp)]
+        z = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F330000))
+        a0, a1, a2 = _PT_A
+        r = (z - row[..., 0]) * row[..., 1]
+        lz = row[..., 2] + r * ((a2 * r + a1) * r + a0)
+        y32 = F32(32.0) * y
+        yh = _as_f32(_as_u32(y32) & U32(0xFFFFF000))
+        yl = y32 - yh
+        th = yh * kf
+        tl = yl * kf + y32 * lz
+        t = th + tl
+        fast = fast & ((np.abs(y) <= F32(float.fromhex("0x1.fp-1"))) | (np.abs(t) < F32(32.0) * POWF_FUSED_MAX_T))
+        bt = t + _MAGIC
+        nf = bt - _MAGIC
+        u = (th - nf) + tl
+        b0, b1, b2 = _PT_B
+        q = u * ((b2 * u + b1) * u + b0)
+        s = _as_f32(_PT_EXP2[(_as_u32(bt) & U32(31)).astype(np.intp)] + ((_as_u32(bt) >> U32(5)) << U32(23)))
+        res = s + s * q
+        out = np.where(fast, res, powf_pos(x, y))
+    return _check(out)
+
+
+# ---------------------------------------------------------------- powf_const (sg_math.h)
+
+#: powf_const: error <= POWC_ULP ulp for x positive normal. Exhaustive over all positive normal x
+#: (independent 60-digit Decimal reference): 2.545 ulp for y = float32(0.8) at x = 0x1.6a09dp+87,
+#: 2.348 for y = float32(-0.2); sampled elsewhere (tests/test_detmath.py, docs/math.md).
+POWC_ULP = 2.6
+SG_POWC_NK = 255
+
+
+class PowC(NamedTuple):
+    """The tables of sg_powc_t for one exponent y (float32 arrays, the C struct's fields)."""
+    y: np.float32
+    p: tuple  # p0 .. p3, float32
+    cy: np.ndarray  # (32,) c_i^y
+    ek: np.ndarray  # (255,) 2^(y k), k = -126 .. 128
+
+
+def _decimal_pow(base: float, exponent: float):
+    """base**exponent for base > 0 from the exact binary values, to 40 significant digits."""
+    with decimal.localcontext() as ctx:
+        ctx.prec = 40
+        return (decimal.Decimal(exponent) * decimal.Decimal(base).ln()).exp()
+
+
+@functools.lru_cache(maxsize=64)
+def _powc_tables(ybits: int) -> PowC:
+    y32 = np.uint32(ybits).view(F32)
+    y = float(y32)
+    if not (math.isfinite(y) and abs(y) < 1.0):
+        raise ValueError(f"powc_tables: |y| must be < 1, got {y!r}")
+    p = (y, y * (y - 1.0) / 2.0, y * (y - 1.0) * (y - 2.0) / 6.0, y * (y - 1.0) * (y - 2.0) * (y - 3.0) / 24.0)
+    # Decimal, not float `**`: the host's libm pow may differ between machines, and the generated
+    # sources must be byte-identical everywhere (exact y, 40 digits, then rounded).
+    cy = np.array([float(_decimal_pow(float(c), y)) for c in _PT_LOG[:, 0]], dtype=F32)
+    # |y| <= 31/32 keeps every entry (and result) normal; closer to 1 the ends are clamped to the
+    # float32 range (deterministic, outside the asserted error bound)
+    ek = np.array([min(float(_decimal_pow(2.0, y * k)), float(np.finfo(F32).max)) for k in range(-126, 129)],
+                  dtype=F32)
+    return PowC(y32, tuple(F32(v) for v in p), cy, ek)
+
+
+def powc_tables(y) -> PowC:
+    """sg_powc_t for the float32 exponent y (|y| < 1; error bound asserted for |y| <= 31/32): p from Taylor coefficients, c_i^y and
+    2^(y k) in float64 rounded once to float32. Emitted by the code generator, used by the twin."""
+    return _powc_tables(int(F32(y).view(np.uint32)))
+
+
+def powc_c_initializer(t: PowC, indent: str = "    ") -> str:
+    """The C initializer of an sg_powc_t (hex-float literals, 8 per line)."""
+    from codegen.emit import c_float as _c_hex  # the one float32 -> exact C literal (keeps -0, refuses NaN)
+
+    def rows(a):
+        return (",\n" + indent * 2).join(", ".join(_c_hex(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
+    return ("{\n" + indent + _c_hex(t.y) + ",\n" + indent + "{" + ", ".join(_c_hex(v) for v in t.p) + "},\n"
+            + indent + "{\n" + indent * 2 + rows(t.cy) + "\n" + indent + "},\n"
+            + indent + "{\n" + indent * 2 + rows(t.ek) + "\n" + indent + "}\n}")
+
+
+def powf_const(x, t: PowC) -> np.ndarray:
+    """Mirror of sg_powf_const (sg_math.h): x^y from the tables t = powc_tables(y) for x positive
+    normal; otherwise powf_pos(x, y)."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        bx = _as_u32(x)
+        fast = (bx - U32(0x00800000)) < U32(0x7F000000)
+        ix = bx + U32(0x3F800000 - 0x3F330000)
+        i = ((ix >> U32(18)) & U32(31)).astype(np.intp)
+        row = _PT_LOG[i]
+        z = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F330000))
+        kk = np.clip((ix >> U32(23)).astype(np.intp) - 1, 0, SG_POWC_NK - 1)
+        p0, p1, p2, p3 = t.p
+        r = (z - row[..., 0]) * row[..., 1]
+        q = r * (((p3 * r + p2) * r + p1) * r + p0)
+        s = t.cy[i] * t.ek[kk]
+        res = s + s * q
+        out = np.where(fast, res, powf_pos(x, t.y))
+    return _check(np.asarray(out, dtype=F32))
+
+
+# ---------------------------------------------------------------- logf_tab (sg_math.h)
+
+_LT_ROWS = np.array([
+    (float.fromhex("0x1.6ap-1"), float.fromhex("0x1.6a13cep+0"), float.fromhex("-0x1.63003p-2")),
+    (float.fromhex("0x1.72p-1"), float.fromhex("0x1.623fa8p+0"), float.fromhex("-0x1.4c9e0ap-2")),
+    (float.fromhex("0x1.7ap-1"), float.fromhex("0x1.5ac056p+0"), float.fromhex("-0x1.36b678p-2")),
+    (float.fromhex("0x1.82p-1"), float.fromhex("0x1.539094p+0"), float.fromhex("-0x1.214456p-2")),
+    (float.fromhex("0x1.8ap-1"), float.fromhex("0x1.4cab88p+0"), float.fromhex("-0x1.0c42d6p-2")),
+    (float.fromhex("0x1.92p-1"), float.fromhex("0x1.460cbcp+0"), float.fromhex("-0x1.ef5adep-3")),
+    (float.fromhex("0x1.9ap-1"), float.fromhex("0x1.3fb014p+0"), float.fromhex("-0x1.c6ffbcp-3")),
+    (float.fromhex("0x1.a2p-1"), float.fromhex("0x1.3991c2p+0"), float.fromhex("-0x1.9f6c4p-3")),
+    (float.fromhex("0x1.aap-1"), float.fromhex("0x1.33ae46p+0"), float.fromhex("-0x1.7898d8p-3")),
+    (float.fromhex("0x1.b2p-1"), float.fromhex("0x1.2e025cp+0"), float.fromhex("-0x1.527e5ep-3")),
+    (float.fromhex("0x1.bap-1"), float.fromhex("0x1.288b02p+0"), float.fromhex("-0x1.2d161p-3")),
+    (float.fromhex("0x1.c2p-1"), float.fromhex("0x1.234568p+0"), float.fromhex("-0x1.08598cp-3")),
+    (float.fromhex("0x1.cap-1"), float.fromhex("0x1.1e2ef4p+0"), float.fromhex("-0x1.c8858p-4")),
+    (float.fromhex("0x1.d2p-1"), float.fromhex("0x1.194538p+0"), float.fromhex("-0x1.8197e2p-4")),
+    (float.fromhex("0x1.dap-1"), float.fromhex("0x1.1485fp+0"), float.fromhex("-0x1.3bdf5ap-4")),
+    (float.fromhex("0x1.e2p-1"), float.fromhex("0x1.0fef02p+0"), float.fromhex("-0x1.eea31cp-5")),
+    (float.fromhex("0x1.eap-1"), float.fromhex("0x1.0b7e6ep+0"), float.fromhex("-0x1.67c95p-5")),
+    (float.fromhex("0x1.f2p-1"), float.fromhex("0x1.07326p+0"), float.fromhex("-0x1.c63d2ep-6")),
+    (float.fromhex("0x1.fap-1"), float.fromhex("0x1.03091cp+0"), float.fromhex("-0x1.82448ap-7")),
+    (float.fromhex("0x1.0p+0"), float.fromhex("0x1.0p+0"), 0.0),
+    (float.fromhex("0x1.0ap+0"), float.fromhex("0x1.ecc07cp-1"), float.fromhex("0x1.39e87cp-5")),
+    (float.fromhex("0x1.12p+0"), float.fromhex("0x1.de5d6ep-1"), float.fromhex("0x1.16536ep-4")),
+    (float.fromhex("0x1.1ap+0"), float.fromhex("0x1.d0cb58p-1"), float.fromhex("0x1.8c345ep-4")),
+    (float.fromhex("0x1.22p+0"), float.fromhex("0x1.c3f8fp-1"), float.fromhex("0x1.fec914p-4")),
+    (float.fromhex("0x1.2ap+0"), float.fromhex("0x1.b7d6c4p-1"), float.fromhex("0x1.371fc2p-3")),
+    (float.fromhex("0x1.32p+0"), float.fromhex("0x1.ac5702p-1"), float.fromhex("0x1.6d60fep-3")),
+    (float.fromhex("0x1.3ap+0"), float.fromhex("0x1.a16d4p-1"), float.fromhex("0x1.a23bc2p-3")),
+    (float.fromhex("0x1.42p+0"), float.fromhex("0x1.970e5p-1"), float.fromhex("0x1.d5c216p-3")),
+    (float.fromhex("0x1.4ap+0"), float.fromhex("0x1.8d3018p-1"), float.fromhex("0x1.04025ap-2")),
+    (float.fromhex("0x1.52p+0"), float.fromhex("0x1.83c978p-1"), float.fromhex("0x1.1c898cp-2")),
+    (float.fromhex("0x1.5ap+0"), float.fromhex("0x1.7ad22p-1"), float.fromhex("0x1.347ddap-2")),
+    (float.fromhex("0x1.62p+0"), float.fromhex("0x1.724288p-1"), float.fromhex("0x1.4be5fap-2")),
+], dtype=F32)
+#: logf_tab: error <= LOGF_TAB_ULP ulp for x positive normal (sampled, tests/test_detmath.py).
+LOGF_TAB_ULP = 3.0
+
+
+def logf_tab(x) -> np.ndarray:
+    """Mirror of sg_logf_tab (sg_math.h): table-driven ln x for x positive normal; else logf(x)."""
+    x = _f32(x)
+    with np.errstate(all="ignore"):
+        bx = _as_u32(x)
+        fast = (bx - U32(0x00800000)) < U32(0x7F000000)
+        ix = bx + U32(0x3F800000 - 0x3F330000)
+        kf = ((ix >> U32(23)).astype(np.int32) - np.int32(127)).astype(F32)
+        row = _LT_ROWS[((ix >> U32(18)) & U32(31)).astype(np.intp)]
+        z = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F330000))
+        r = (z - row[..., 0]) * row[..., 1]
+        p = (((F32(float.fromhex("0x1.99999ap-3")) * r - F32(0.25)) * r + F32(float.fromhex("0x1.555556p-2"))) * r
+             - F32(0.5)) * r
+        lz = row[..., 2] + r * (p + F32(1.0))
+        res = kf * F32(float.fromhex("0x1.62e4p-1")) + (kf * F32(float.fromhex("0x1.7f7d1cp-20")) + lz)
+        out = np.where(fast, res, logf(x))
+    return _check(np.asarray(out, dtype=F32))

@@ -182,6 +182,13 @@ def pid(cfg: cs.ControllerConfig, integral: np.ndarray, x: np.ndarray, time_ok: 
     return raw, np.where(ok, nxt, integral)
 
 
+def repair_integral(cfg: cs.ControllerConfig, integral: np.ndarray):
+    """repair_integral: a non-finite or out-of-limit integrator restarts at 0 (and is flagged)."""
+    ilim = _f(cfg.integral_limit)
+    ok = (integral >= -ilim) & (integral <= ilim)
+    return np.where(ok, integral, _f(0.0)), ~np.all(ok, axis=1)
+
+
 def update_mode(cfg: cs.ControllerConfig, mode: np.ndarray, clean_count: np.ndarray, clean: np.ndarray):
     dwell = U32(cfg.dwell_steps)
     pid_mode = mode != U32(0)
@@ -240,7 +247,8 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     for i in range(x.shape[1]):
         status |= np.where(inside[:, i], U32(0), U32(1 << (cs.STATUS_BOUND_SHIFT + i)))
     status |= np.where(valid, U32(0), U32(cs.STATUS_INPUT_INVALID))
-    raw, integral = pid(cfg, state["integral"], x, time_ok)
+    integral, repaired = repair_integral(cfg, state["integral"])
+    raw, integral = pid(cfg, integral, x, time_ok)
     mode, count = update_mode(cfg, state["mode"], state["clean"], status == 0)
     nn = mode == U32(0)
     y = golden.network_eval(a, np.ascontiguousarray(x))
@@ -250,7 +258,7 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     sat = np.any(~((cmd >= -lim) & (cmd <= lim)), axis=1)
     status |= np.where(sat, U32(cs.STATUS_SATURATED), U32(0))
     out["torque"] = clip(cmd, lim)
-    out["status"] = status
+    out["status"] = status | np.where(repaired, U32(cs.STATUS_STATE_REPAIRED), U32(0))
     new = np.zeros(inp.shape, dtype=STATE_DTYPE)
     new["integral"], new["mode"], new["clean"] = integral, mode, count
     return out, new

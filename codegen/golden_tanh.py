@@ -4,7 +4,7 @@ Operation for operation and in the same order as the C, vectorised across N inde
 states: a 3-vector is a tuple of three (N,) float32 arrays, R_e nine of them; every C branch
 is a mask (np.where), both sides computed, the taken one kept. Sums are written out left to
 right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin): tanhf,
-logf, sqrtf, powf_fused; |x|^γ = |x|·powf_fused(|x|, γ−1) in f (11), powf_fused(|x|, γ) in
+logf_tab, sqrtf, powf_const; |x|^γ = |x|·powf_const(|x|, γ−1) in f (11), powf_const(|x|, γ) in
 u_a (20), as in the C. Constants are the float32 values of codegen.tanh_emit.constants32, the
 same ones the C carries as hex floats. Every stage asserts float32 (numpy 2 promotes float32
 with a float64 scalar).
@@ -80,7 +80,7 @@ def shaping(k: Constants32, x):
     """(f(x), f'(x)) of eq. 11 as the C computes them."""
     ax = np.abs(x)
     inside = ax <= k.eta
-    q = detmath.powf_fused(ax, k.gamma_m1)  # |x|^(γ-1): f = sign(x)|x|q, f' = γq (no division)
+    q = detmath.powf_const(ax, detmath.powc_tables(k.gamma_m1))  # |x|^(γ-1): f = sign(x)|x|q, f' = γq (no division)
     p = ax * q
     f = np.where(inside, k.r1 * x + (k.r2 * x) * ax, np.where(x < F32(0.0), -p, p))
     slope = np.where(inside, k.r1 + k.r2x2 * ax, k.gamma * q)
@@ -88,7 +88,7 @@ def shaping(k: Constants32, x):
 
 
 def sig_pow(k: Constants32, d):
-    p = detmath.powf_fused(np.abs(d), k.gamma)
+    p = detmath.powf_const(np.abs(d), detmath.powc_tables(k.gamma))
     return _f32(np.where(d < F32(0.0), -p, p), "sig_pow")
 
 
@@ -113,7 +113,7 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     """(u, vdot, x2) of law (10)-(20), as {name}_nominal."""
     inv_q0 = F32(4.0) * k_e
     kk = F32(2.0) / (q0 * q0 + nsq)
-    barrier = k.lam * detmath.logf(om)
+    barrier = k.lam * detmath.logf_tab(om)
     fs = [shaping(k, x1[i]) for i in range(3)]
     g = _v(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
     w_ev = e_solve(q0, inv_q0, kk, x1, g)

@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from codegen import GENERATOR_VERSION
+from codegen import GENERATOR_VERSION, detmath
 from codegen.emit import _environment, c_float, check_name, math_sources, write_sources
 from codegen.errors import CodegenError
 from codegen.tanh_params import TanhParams, derived_constants
@@ -83,9 +83,23 @@ def _text(value: float) -> str:
     return f"{value:.9g}"
 
 
+def sqrt_gt_threshold(n1: np.float32) -> np.float32:
+    """The largest float32 d with sqrtf(d) <= n1 (n1 > 0 finite): IEEE sqrt is correctly rounded
+    and monotone, so sqrtf(d) > n1 <=> d > this, for every float32 d (NaN: both false)."""
+    n1 = np.float32(n1)
+    with np.errstate(over="ignore"):
+        d = np.minimum(np.float32(n1 * n1), np.finfo(np.float32).max)
+        while np.sqrt(d) > n1:
+            d = np.nextafter(d, np.float32(0.0))
+        while d < np.finfo(np.float32).max and np.sqrt(np.nextafter(d, np.float32(np.inf))) <= n1:
+            d = np.nextafter(d, np.float32(np.inf))
+    return np.float32(d)
+
+
 def template_context(p: TanhParams, period: float, name: str) -> dict:
     c = constants32(p, period)
     literal = {k: c_float(v) for k, v in c.scalars.items()}
+    literal["n1_dsq"] = c_float(sqrt_gt_threshold(c.n1))
     literal["J"] = [c_float(v) for v in c.J]
     literal["J_inv"] = [c_float(v) for v in c.J_inv]
     items = [f"{k} = {_text(v)}" if not isinstance(v, list) else
@@ -102,6 +116,8 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "period": c_float(c.period), "period_text": _text(period),
         "limit_text": _text(p.varpi_limit), "q0_min_text": _text(p.q0_min),
         "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
+        "pow_gamma_m1": detmath.powc_c_initializer(detmath.powc_tables(c.gamma_m1)),
+        "pow_gamma": detmath.powc_c_initializer(detmath.powc_tables(c.gamma)),
     }
 
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import re
 import shutil
 import subprocess
 import tempfile
@@ -24,6 +23,7 @@ from typing import Mapping, Sequence
 import jinja2
 import numpy as np
 
+from firmware import symbols
 from firmware.errors import FirmwareError
 from firmware.flags import ARM_CC, ARM_CPU, COMMON, with_opt
 
@@ -38,10 +38,7 @@ EXTRA_CFLAGS = ["-fstack-usage", "-ffunction-sections", "-fdata-sections"]
 BUILD_LAYOUT = "1"
 
 # Names that would mean libm (or a vendor HAL) got linked in.
-_LIBM = re.compile(r"^(__ieee754_\w+|__kernel_\w+|(a?sin|a?cos|a?tan|atan2|sinh|cosh|tanh|exp|exp2|"
-                   r"expm1|log|log2|log10|log1p|pow|sqrt|cbrt|hypot|fmod|floor|ceil|round|"
-                   r"trunc|frexp|ldexp|modf|erf|erfc|lgamma|tgamma)[fl]?)$")
-_HAL = re.compile(r"^(HAL_|LL_|SystemInit$|SystemCoreClock)")
+_LIBM, _HAL = symbols.LIBM, symbols.HAL
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from typing import Mapping
 
 import numpy as np
 
+from firmware import symbols
 from firmware.errors import FirmwareError
 from firmware.flags import COMMON
 
@@ -108,7 +109,22 @@ def compile_objects(src_dir: Path, obj_dir: Path, cc: str = X86_CC) -> list[Path
         if res.returncode != 0:
             raise FirmwareError(f"x86 build: {c_file.name} does not compile: {_one_line(res.stderr)}")
         objects.append(obj)
+    check_undefined(objects)
     return objects
+
+
+def check_undefined(objects: list[Path]) -> None:
+    """Flight objects may reference no libm or allocation function: inside the Python process
+    such a call would silently resolve to the host's libm (SPEC section 5)."""
+    try:
+        res = subprocess.run(["nm", "--undefined-only", *map(str, objects)], capture_output=True, text=True,
+                             check=False)
+    except FileNotFoundError:
+        raise FirmwareError("x86 build: 'nm' (binutils) not found on PATH") from None
+    names = {ln.split()[-1] for ln in res.stdout.splitlines() if ln.strip() and not ln.endswith(":")}
+    bad = sorted(n for n in names if symbols.LIBM.match(n) or symbols.ALLOCATION.match(n))
+    if bad:
+        raise FirmwareError(f"x86 build: flight code references forbidden library symbols: {', '.join(bad[:5])}")
 
 
 def _build_into(folder: Path, key: str, sources: Mapping[str, str], cdef: str, harness: str, cc: str) -> None:

@@ -100,11 +100,18 @@ def make_inputs(g: Geometry, A_bd: np.ndarray, omega_e: np.ndarray) -> np.ndarra
     return inp
 
 
+CORRUPT_INTEGRALS = np.array([np.nan, np.inf, -np.inf, 3.4028235e38, -1e6, 1e6], dtype=np.float32)
+CORRUPT_SHARE = 0.02
+
+
 def random_states(rng: np.random.Generator, n: int, dwell: int) -> np.ndarray:
+    """Reachable states, plus a few corrupted integrators (bit flips) that the step must repair."""
     st = gc.init(n)
     st["integral"] = rng.uniform(-1.0, 1.0, (n, 3))
     st["mode"] = rng.integers(0, 2, n)
     st["clean"] = rng.integers(0, dwell + 1, n)
+    bad = np.flatnonzero(rng.random(n) < CORRUPT_SHARE)
+    st["integral"][bad, rng.integers(0, 3, bad.size)] = rng.choice(CORRUPT_INTEGRALS, bad.size)
     return st
 
 

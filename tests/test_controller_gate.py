@@ -56,6 +56,26 @@ def test_three_way_gate_independent_steps(artifact, cfg, vectors):
     assert invalid[kind == 2].mean() > 0.3 and pid[invalid].all() and not invalid[kind == 0].any()
 
 
+def test_corrupted_integrator_is_repaired_and_flagged(artifact, cfg, vectors):
+    """A NaN/Inf/huge integrator in the caller's state restarts at 0 with a status bit (all targets)."""
+    _, inputs, kind = vectors
+    rows = np.flatnonzero(kind == 0)[:len(gate.CORRUPT_INTEGRALS) * 3]
+    states = gc.init(rows.size)
+    states["mode"] = 1  # the PID flies: a silenced axis would show in the torque
+    for k in range(rows.size):
+        states["integral"][k, k % 3] = gate.CORRUPT_INTEGRALS[k // 3]
+    g_out, g_state = gc.step(artifact, cfg, states, inputs[rows])
+    assert np.all(g_out["status"] & cs.STATUS_STATE_REPAIRED)
+    assert np.all(np.isfinite(g_out["torque"])) and np.all(np.abs(g_out["torque"]) <= cfg.torque_limit)
+    assert np.all(np.abs(g_state["integral"]) <= cfg.integral_limit)
+    for out, st in (X86Controller(artifact, cfg).run_records(states, inputs[rows]),
+                    gate.ArmRunner(artifact, cfg).run_records(states, inputs[rows])):
+        assert gate.compare_outputs(g_out, out) == [] and gate.compare_states(g_state, st) == []
+    # healthy states never raise it
+    healthy, _ = gc.step(artifact, cfg, gc.init(rows.size), inputs[rows])
+    assert not np.any(healthy["status"] & cs.STATUS_STATE_REPAIRED)
+
+
 def test_three_way_gate_sequences_with_mode_switches(artifact, cfg):
     seqs = gate.sequence_inputs(N_SEQ, SEQ_STEPS, seed=5)
     g = gc.run_sequences(artifact, cfg, seqs)

@@ -26,9 +26,10 @@ UNARY = ["tanhf", "expf", "logf", "sinf", "cosf", "asinf", "sqrtf"]
 BINARY = ["atan2f", "powf_pos"]
 F32 = np.float32
 
+POWC_YS = {"g": 0.8, "gm1": -0.2, "half": 0.5, "m31": -31 / 32, "p31": 31 / 32, "tiny": 1e-3}
 WRAPPERS = "\n".join(
     [f"void batch_{n}(const float *x, float *y, int n) {{ for (int i = 0; i < n; i++) "
-     f"y[i] = sg_{n}(x[i]); }}" for n in UNARY]
+     f"y[i] = sg_{n}(x[i]); }}" for n in [*UNARY, "logf_tab"]]
     + [f"void batch_{n}(const float *a, const float *b, float *y, int n) {{ for (int i = 0; "
        f"i < n; i++) y[i] = sg_{n}(a[i], b[i]); }}" for n in BINARY]
     + ["void batch_inline_tanhf(const float *x, float *y, int n) { for (int i = 0; i < n; i++) "
@@ -38,7 +39,14 @@ WRAPPERS = "\n".join(
        "void batch_powf_fused(const float *a, const float *b, float *y, int n) { for (int i = 0; "
        "i < n; i++) y[i] = sg_powf_fused(a[i], b[i]); }",
        "void batch_powf_fused_08(const float *a, float *y, int n) { for (int i = 0; i < n; i++) "
-       "y[i] = sg_powf_fused(a[i], 0x1.99999ap-1f); }"])
+       "y[i] = sg_powf_fused(a[i], 0x1.99999ap-1f); }",
+       "void batch_powf_tab(const float *a, const float *b, float *y, int n) { for (int i = 0; "
+       "i < n; i++) y[i] = sg_powf_tab(a[i], b[i]); }",
+       "void batch_powf_tab_08(const float *a, float *y, int n) { for (int i = 0; i < n; i++) "
+       "y[i] = sg_powf_tab(a[i], 0x1.99999ap-1f); }",
+       *[f"static const sg_powc_t powc_{n} = {dm.powc_c_initializer(dm.powc_tables(y))};\n"
+         f"void batch_powc_{n}(const float *x, float *y, int n) {{ for (int i = 0; i < n; i++) "
+         f"y[i] = sg_powf_const(x[i], &powc_{n}); }}" for n, y in POWC_YS.items()]])
 
 
 OPT_LEVELS = ["-O2", "-O0", "-Os"]  # the flight level and the benchmark levels (with_opt)
@@ -55,9 +63,10 @@ def clib(request, tmp_path_factory):
                     str(CSRC / "sg_math.c"), str(d / "wrap.c"), "-o", str(so)], check=True)
     ffi = cffi.FFI()
     ffi.cdef("\n".join([f"void batch_{n}(const float *, float *, int);"
-                        for n in [*UNARY, "inline_tanhf", "inline_tanhf_full", "powf_fused_08"]]
+                        for n in [*UNARY, "logf_tab", "inline_tanhf", "inline_tanhf_full", "powf_fused_08",
+                                  "powf_tab_08", *[f"powc_{n}" for n in POWC_YS]]]
                        + [f"void batch_{n}(const float *, const float *, float *, int);"
-                          for n in [*BINARY, "powf_fused"]]))
+                          for n in [*BINARY, "powf_fused", "powf_tab"]]))
     lib = ffi.dlopen(str(so))
 
     def call(name: str, *args: np.ndarray) -> np.ndarray:
@@ -485,3 +494,111 @@ def test_arm_emulated_powf_fused_equals_twin(tmp_path):
     y_arm = call("powf_fused_call", x.view(np.uint32), y.view(np.uint32))
     bad = ~same(dm.powf_fused(x, y), y_arm)
     assert not bad.any(), (x[bad][:5], y[bad][:5])
+
+
+# ---------------------------------------------------------------- sg_powf_tab (sg_math.h)
+
+def test_powf_tab_twin_equals_c(clib):
+    """sg_powf_tab == detmath.powf_tab bit for bit on >= 1e5 fast-path pairs, every special pair
+    and random bit patterns, at each optimisation level; also with a constant y (0.8)."""
+    x, y = powf_fused_inputs(np.random.default_rng(31))
+    assert x.size >= 100_000
+    y_twin, y_c = dm.powf_tab(x, y), clib("powf_tab", x, y)
+    bad = ~same(y_twin, y_c)
+    assert not bad.any(), (x[bad][:5], y[bad][:5], y_twin[bad][:5], y_c[bad][:5])
+    x8 = np.concatenate([np.abs(x), x])
+    bad = ~same(dm.powf_tab(x8, F32(0.8)), clib("powf_tab_08", x8))
+    assert not bad.any(), x8[bad][:5]
+
+
+def test_powf_tab_sampled_ulp_bound():
+    """Fast path: error <= POWF_TAB_ULP_BASE + POWF_TAB_ULP_PER_Y |y| ulp on 1e6 samples
+    (docs/math.md); the tanh law's exponents (0.8, -0.2) within 1.4 ulp on (1e-8, 1e4]."""
+    rng = np.random.default_rng(32)
+    x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
+    y = (rng.uniform(-4, 4, x.size) * np.minimum(1.0, 120.0 / np.maximum(np.abs(np.log2(x.astype(np.float64))), 1.0)))
+    y = y.astype(F32)
+    with np.errstate(all="ignore"):
+        t = y.astype(np.float64) * np.log2(x.astype(np.float64))
+    ok = np.abs(t) < 124.0
+    x, y = x[ok], y[ok]
+    ref = np.power(x.astype(np.float64), y.astype(np.float64))
+    err = ulp_error(dm.powf_tab(x, y), ref)
+    bound = dm.POWF_TAB_ULP_BASE + dm.POWF_TAB_ULP_PER_Y * np.abs(y.astype(np.float64))
+    assert (err <= bound).all(), (err[err > bound][:3], x[err > bound][:3], y[err > bound][:3])
+    x = np.exp(rng.uniform(np.log(1e-8), np.log(1e4), 200_000)).astype(F32)
+    for g in (F32(0.8), F32(-0.2)):
+        err = ulp_error(dm.powf_tab(x, g), np.power(x.astype(np.float64), float(g)))
+        assert err.max() <= 1.4, (g, err.max())
+
+
+@pytest.mark.parametrize("x,y,want", EDGES_POW_FUSED)
+def test_edge_cases_powf_tab(clib, x, y, want):
+    """Special values (through sg_powf_pos) and exact powers of two on the fast path."""
+    got_twin = dm.powf_tab(x, y)
+    got_c = clib("powf_tab", np.array([x], F32), np.array([y], F32))[0]
+    assert same(np.asarray(got_twin, F32), np.asarray(got_c, F32))
+    if want is None:
+        assert same(np.asarray(got_twin, F32), dm.powf_pos(x, y))
+    else:
+        assert same(np.asarray(got_twin, F32), np.asarray(want, F32)), (x, y, got_twin, want)
+
+
+# ---------------------------------------------------------------- sg_powf_const (sg_math.h)
+
+def test_powf_const_twin_equals_c(clib):
+    """sg_powf_const == detmath.powf_const bit for bit for six exponents (the tanh law's 0.8 and
+    -0.2, the ends +-31/32), >= 1e5 positive normals, special values and random bit patterns."""
+    x, _ = powf_fused_inputs(np.random.default_rng(41))
+    assert x.size >= 100_000
+    x = np.concatenate([x, np.abs(x), SPECIALS, -SPECIALS])
+    for n, y in POWC_YS.items():
+        y_twin, y_c = dm.powf_const(x, dm.powc_tables(y)), clib(f"powc_{n}", x)
+        bad = ~same(y_twin, y_c)
+        assert not bad.any(), (n, x[bad][:5], y_twin[bad][:5], y_c[bad][:5])
+
+
+def test_powf_const_sampled_ulp_bound():
+    """Error <= POWC_ULP ulp on 1e6 positive normals (log-uniform) per exponent; edge cases:
+    x not a positive normal takes powf_pos (1^y is not exact: c_i != 1)."""
+    rng = np.random.default_rng(42)
+    x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
+    for y in [*POWC_YS.values(), 0.1, -0.6]:
+        t = dm.powc_tables(y)
+        err = ulp_error(dm.powf_const(x, t), np.power(x.astype(np.float64), float(t.y)))
+        assert err.max() <= dm.POWC_ULP, (y, err.max())
+    t = dm.powc_tables(0.8)
+    for xs in (0.0, -0.0, -2.0, np.inf, np.nan, 2.0**-130):
+        assert same(np.asarray(dm.powf_const(xs, t), F32), np.asarray(dm.powf_pos(xs, t.y), F32))
+    with pytest.raises(ValueError):
+        dm.powc_tables(1.0)
+    assert np.isfinite(dm.powc_tables(1.0 - 2.0**-24).ek).all()
+
+
+# ---------------------------------------------------------------- sg_logf_tab (sg_math.h)
+
+def test_logf_tab_twin_equals_c(clib):
+    """sg_logf_tab == detmath.logf_tab bit for bit on >= 1e5 positive normals (log-uniform, and
+    1 - 10^-8 .. 1), special values and random bit patterns, at each optimisation level."""
+    rng = np.random.default_rng(51)
+    x = np.concatenate([np.exp2(rng.uniform(-126, 128, 100_000)).astype(F32),
+                        (1.0 - np.exp(rng.uniform(np.log(1e-8), 0.0, 50_000))).astype(F32), SPECIALS, -SPECIALS,
+                        rng.integers(0, 2**32, 50_000, dtype=np.uint64).astype(np.uint32).view(F32)])
+    y_twin, y_c = dm.logf_tab(x), clib("logf_tab", x)
+    bad = ~same(y_twin, y_c)
+    assert not bad.any(), (x[bad][:5], y_twin[bad][:5], y_c[bad][:5])
+
+
+def test_logf_tab_sampled_ulp_bound():
+    """Error <= LOGF_TAB_ULP ulp on 2e6 positive normals (uniform bit patterns and near 1);
+    ln 1 = 0 exactly; x not a positive normal gives logf(x)."""
+    rng = np.random.default_rng(52)
+    x = np.concatenate([rng.integers(0x00800000, 0x7F800000, 1_000_000, dtype=np.uint64).astype(np.uint32).view(F32),
+                        (1.0 - np.exp(rng.uniform(np.log(1e-8), 0.0, 500_000))).astype(F32),
+                        np.exp(rng.uniform(-0.1, 0.1, 500_000)).astype(F32)])
+    x = x[x != F32(1.0)]
+    err = ulp_error(dm.logf_tab(x), np.log(x.astype(np.float64)))
+    assert err.max() <= dm.LOGF_TAB_ULP, err.max()
+    assert dm.logf_tab(1.0) == F32(0.0)
+    for xs in (0.0, -0.0, -2.0, np.inf, np.nan, 2.0**-130):
+        assert same(np.asarray(dm.logf_tab(xs), F32), np.asarray(dm.logf(xs), F32))

@@ -172,3 +172,15 @@ def test_cli_codegen_writes_the_four_files(monkeypatch, capsys, tmp_path, artifa
     assert cli.main(["codegen", "--artifact", str(path), "--out", str(tmp_path / "g2"), "--name", "Bad"]) == 2
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "--name" in err
+
+
+def test_x86_build_refuses_flight_code_that_calls_libm(tmp_path):
+    """Inside the Python process a tanhf call would silently bind to the host libm: refused."""
+    from firmware import x86
+    from firmware.errors import FirmwareError
+
+    src = tmp_path / "src"
+    src.mkdir()
+    (src / "bad.c").write_text("float tanhf(float);\nfloat f(float x);\nfloat f(float x) { return tanhf(x); }\n")
+    with pytest.raises(FirmwareError, match="tanhf"):
+        x86.compile_objects(src, tmp_path / "obj")

@@ -238,3 +238,20 @@ def test_params_error_class_is_a_codegen_error():
     with pytest.raises(CodegenError, match="control period"):
         tanh_emit.constants32(PARAMS, -0.1)
     assert math.isclose(float(K.period), 0.1, rel_tol=1e-7)
+
+
+@pytest.mark.parametrize("n1", [0.05, 0.1, 1e-3, 0.3, 2.0, 1e-20, 1.9e19, 3e38])
+def test_n1_dsq_threshold_matches_the_sqrt_branch(n1):
+    """The generated N1_DSQ: sqrtf(d) > n1 <=> d > N1_DSQ for every float32 d (checked at the
+    threshold's neighbours and on random bit patterns), so u_a's branch needs no VSQRT inside n1."""
+    from codegen.tanh_emit import sqrt_gt_threshold
+    n = np.float32(n1)
+    t = sqrt_gt_threshold(n)
+    assert np.sqrt(t) <= n
+    assert t == np.finfo(np.float32).max or np.sqrt(np.nextafter(t, np.float32(np.inf))) > n
+    rng = np.random.default_rng(7)
+    d = np.concatenate([rng.integers(0, 0x7F800000, 100_000, dtype=np.uint64).astype(np.uint32).view(np.float32),
+                        (t.view(np.uint32) + np.arange(-50, 51, dtype=np.int64)).clip(0, 0x7F7FFFFF).astype(np.uint32)
+                        .view(np.float32), np.float32([np.inf, np.nan, 0.0])])
+    with np.errstate(invalid="ignore"):
+        assert np.array_equal(np.sqrt(d) > n, d > t)

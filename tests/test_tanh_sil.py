@@ -56,8 +56,9 @@ def test_sil_and_pil_fly_the_same_trajectory(sil, pil):
 def test_pil_reports_cycles_per_step(pil):
     cycles = pil["history"]["cycles"]
     assert cycles.shape == (401,) and pil["cycles_min"] > 1000
-    # regression guard on the measured 1,565-1,923 (the SPEC budget of 1,500 is not met: see docs)
-    assert pil["cycles_max"] <= 2_050
+    # regression guard on the measured 1,411-1,629 (+3 %; the step's worst case over the gate classes,
+    # 1,670, is still above the SPEC budget of 1,500: see docs)
+    assert pil["cycles_max"] <= 1_680
 
 
 def test_cycle_report_of_tanh_step():
@@ -65,13 +66,13 @@ def test_cycle_report_of_tanh_step():
     assert set(rep["by_class"]) == {"random", "small", "delta", "singular", "off_so3", "extreme", "special",
                                     "example"}
     assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
-    assert 0 < rep["flash_bytes"] <= 12 * 1024 and rep["ram_bytes"] == 0 and not rep["newlib"]
-    # the law's nine tanh and six powers are inline (sg_inline_tanhf_full, sg_powf_fused); sg_tanhf is
-    # the 180 deg fallback's six, sg_logf the barrier's one
-    assert {"sg_tanhf", "sg_logf", "tanh_step", "tanh_transcendentals"} <= set(rep["functions"])
-    assert "sg_expf" not in rep["functions"]
+    # 13,320 B measured, of which 2 x 1,160 B the two sg_powc_t tables
+    assert 0 < rep["flash_bytes"] <= 14 * 1024 and rep["ram_bytes"] == 0 and not rep["newlib"]
+    # the law's nine tanh, six powers and one log are inline (sg_inline_tanhf_full, sg_powf_const,
+    # sg_logf_tab); sg_tanhf is the 180 deg fallback's six
+    assert {"sg_tanhf", "tanh_step", "tanh_transcendentals"} <= set(rep["functions"])
+    assert "sg_expf" not in rep["functions"] and "sg_logf" not in rep["functions"]
     assert rep["functions"]["sg_tanhf"]["calls"]["max"] == 6
-    assert rep["functions"]["sg_logf"]["calls"]["max"] == 1
     text = "\n".join(tanh_sil.cycle_text(rep))
     assert "budget (SPEC 8), tanh law step worst case ideal" in text
 

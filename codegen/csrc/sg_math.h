@@ -11,7 +11,8 @@
  * all 2^32 inputs by tools/ulp_sweep.py (sampled for the two-argument functions):
  *   tanh 1.47, exp 1.19, log 0.84, sin 1.02 and cos 1.03 (|x| <= SG_TRIG_MAX_ARG), asin 1.20,
  *   sqrt 0.5 (correctly rounded), atan2 1.53 (sampled); pow see below; sg_powf_fused (fast path,
- *   sampled) 1.59 at y = 0.8, <= 1.2 + |y| in general.
+ *   sampled) 1.59 at y = 0.8, <= 1.2 + |y| in general; sg_powf_tab 1.33 at y = 0.8, <= 1.2 + |y|;
+ *   sg_powf_const 2.31 at y = 0.8, <= 2.5 for |y| <= 31/32; sg_logf_tab 2.88 (all sampled).
  * Published bounds: 2 ulp (3 for atan2). docs/math.md has the table, the methods, the domains
  * and the Cortex-M4 cycle estimates.
  *
@@ -210,6 +211,144 @@ static SG_ALWAYS_INLINE float sg_powf_fused(float x, float y)
     bx.f = 1.0f + r * q;
     bx.u += bt.u << 23;
     return bx.f;
+}
+
+/* ---- sg_powf_tab: sg_powf_fused's domain, table-driven (fewer loads and multiplies) ------
+ * A different function from sg_powf_fused (other bits, same fast-path set and fallback).
+ * log2 x: ix = bits(x) + 0x4d0000, k = (ix >> 23) - 127, z = x / 2^k in
+ * [0x1.66p-1, 0x1.66p+0), i = bits 18..22 of ix picks c_i (the interval's midpoint),
+ * r = (z - c_i) (exact, Sterbenz) * (1/c_i), |r| < 0.0151, log2 z = log2 c_i + r (a0 + r (a1 + r a2))
+ * (absolute error 3.6e-9). With Y = 32 y split as Yh (top 12 bits) + Yl: T = Yh k (exact) +
+ * (Yl k + Y log2 z) = 32 y log2 x, n = round(T) by the magic add, u = (Yh k - n) + (Yl k + Y log2 z)
+ * in [-0.5, 0.5], result = 2^(n >> 5) (S + S q), S = 2^((n & 31)/32) from a 32-entry table of
+ * float32 bits, q = u (b0 + u (b1 + u b2)) = 2^(u/32) - 1 (error 1.3e-10). The exponent is added
+ * to S's bits in the core registers. Fast path as sg_powf_fused's (x positive normal, |y log2 x|
+ * < 125); else sg_powf_pos(x, y). Error and cycles: docs/math.md. */
+#define SG_POWF_TAB_N 32u
+extern const float sg_powf_tab_log[SG_POWF_TAB_N][3]; /* c, 1/c, log2 c */
+extern const float sg_powf_tab_poly[6];                /* a0, a1, a2, b0, b1, b2 */
+extern const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N]; /* bits of 2^(j/32) */
+
+static SG_ALWAYS_INLINE float sg_powf_tab(float x, float y)
+{
+    sg_bits_t bx, by, bt;
+    uint32_t ix;
+    float kf, z, r, lz, y32, yh, yl, th, tl, t, nf, u, q;
+    const float *row;
+    bx.f = x;
+    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
+        return sg_powf_pos(x, y); /* not a positive normal finite float */
+    }
+    ix = bx.u + (0x3f800000u - 0x3f330000u);
+    kf = (float)((int32_t)(ix >> 23) - 127);
+    row = sg_powf_tab_log[(ix >> 18) & 31u];
+    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+    z = bx.f;
+    {
+        const float c = row[0], ic = row[1], lc = row[2];
+        const float a0 = sg_powf_tab_poly[0], a1 = sg_powf_tab_poly[1], a2 = sg_powf_tab_poly[2];
+        SG_LOADS_DONE();
+        r = (z - c) * ic;
+        lz = lc + r * ((a2 * r + a1) * r + a0);
+    }
+    y32 = 32.0f * y;
+    by.f = y32;
+    by.u &= 0xfffff000u;
+    yh = by.f;
+    yl = y32 - yh;
+    th = yh * kf;
+    tl = yl * kf + y32 * lz;
+    t = th + tl;
+    /* |y| <= 31/32 implies |t| <= 32 * 124 for every normal x: the test on t folds away for
+     * such a constant y; the fast-path set is the same either way. */
+    if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < 32.0f * SG_POWF_FUSED_MAX_T), 0)) {
+        return sg_powf_pos(x, y);
+    }
+    bt.f = t + 0x1.8p+23f;
+    nf = bt.f - 0x1.8p+23f;
+    u = (th - nf) + tl;
+    {
+        const float b0 = sg_powf_tab_poly[3], b1 = sg_powf_tab_poly[4], b2 = sg_powf_tab_poly[5];
+        SG_LOADS_DONE();
+        q = u * ((b2 * u + b1) * u + b0);
+    }
+    bx.u = sg_powf_tab_exp2[bt.u & 31u] + ((bt.u >> 5) << 23);
+    return bx.f + bx.f * q;
+}
+
+/* ---- sg_powf_const: x^y for an exponent fixed at generation time -----------------------
+ * For |y| < 1 (error bound for |y| <= 31/32), with tables built for that y by codegen/detmath.powc_tables (the
+ * generator emits them with the code): x = 2^k z as in sg_powf_tab (k in [-126, 128], z in
+ * interval i with midpoint c_i), r = (z - c_i) (exact) * (1/c_i), |r| < 0.0151, and
+ * x^y = (c_i^y 2^(y k)) (1 + q), q = r (p0 + r (p1 + r (p2 + r p3))) = (1 + r)^y - 1 (Taylor,
+ * p0 = y; truncation <= 5e-11 relative): c_i^y and 2^(y k) are float32 table entries (32 and
+ * 255), so there is no exp2 at all and no range test (|y| <= 31/32 keeps every result normal;
+ * closer to 1 the table's ends are clamped to the float32 range).
+ * x not a positive normal float (0, subnormal, negative, +Inf, NaN): sg_powf_pos(x, y).
+ * Error and cycles: docs/math.md. */
+#define SG_POWC_NK 255u /* k = -126 .. 128 */
+typedef struct {
+    float y;                 /* the exponent */
+    float p[4];              /* p0 .. p3 */
+    float cy[SG_POWF_TAB_N]; /* c_i^y */
+    float ek[SG_POWC_NK];    /* 2^(y k), k = -126 .. 128 */
+} sg_powc_t;
+
+static SG_ALWAYS_INLINE float sg_powf_const(float x, const sg_powc_t *t)
+{
+    sg_bits_t bx;
+    uint32_t ix;
+    float z, r, q, s;
+    const float *row;
+    bx.f = x;
+    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
+        return sg_powf_pos(x, t->y); /* not a positive normal finite float */
+    }
+    ix = bx.u + (0x3f800000u - 0x3f330000u);
+    row = sg_powf_tab_log[(ix >> 18) & 31u];
+    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+    z = bx.f;
+    {
+        const float c = row[0], ic = row[1], cy = t->cy[(ix >> 18) & 31u], ek = t->ek[(ix >> 23) - 1u];
+        const float p0 = t->p[0], p1 = t->p[1], p2 = t->p[2], p3 = t->p[3];
+        SG_LOADS_DONE();
+        r = (z - c) * ic;
+        q = r * (((p3 * r + p2) * r + p1) * r + p0);
+        s = cy * ek;
+    }
+    return s + s * q;
+}
+
+/* ---- sg_logf_tab: ln x, table-driven, inline --------------------------------------------
+ * A different function from sg_logf (other bits). x positive normal: x = 2^k z as in
+ * sg_powf_tab, r = (z - c_i) (exact) * (1/c_i) with c_i = 1 in the interval holding 1 (r = z - 1
+ * exactly there), ln z = ln c_i + r (1 + r (-1/2 + r (1/3 + r (-1/4 + r/5)))) (truncation
+ * <= 2e-9 relative), ln x = k ln2_hi (exact) + (k ln2_lo + ln z). Anything else (x <= 0,
+ * subnormal, +Inf, NaN): sg_logf(x). Error and cycles: docs/math.md. */
+extern const float sg_logf_tab_rows[SG_POWF_TAB_N][3]; /* c, 1/c, ln c */
+
+static SG_ALWAYS_INLINE float sg_logf_tab(float x)
+{
+    sg_bits_t bx;
+    uint32_t ix;
+    float kf, z, r, lz;
+    const float *row;
+    bx.f = x;
+    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
+        return sg_logf(x); /* not a positive normal finite float */
+    }
+    ix = bx.u + (0x3f800000u - 0x3f330000u);
+    kf = (float)((int32_t)(ix >> 23) - 127);
+    row = sg_logf_tab_rows[(ix >> 18) & 31u];
+    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+    z = bx.f;
+    {
+        const float c = row[0], ic = row[1], lc = row[2];
+        SG_LOADS_DONE();
+        r = (z - c) * ic;
+        lz = lc + r * (((((0x1.99999ap-3f * r - 0x1.0p-2f) * r + 0x1.555556p-2f) * r - 0x1.0p-1f) * r) + 1.0f);
+    }
+    return kf * 0x1.62e4p-1f + (kf * 0x1.7f7d1cp-20f + lz);
 }
 
 #endif /* SG_MATH_H */
