@@ -1,6 +1,7 @@
 """The one place that states the compiler flags of SPEC section 5, for both targets."""
 
-# Shared by x86-64 (SIL, cffi) and the Cortex-M4F (PIL). Never -ffast-math, -Ofast, -march=native.
+# Shared by x86-64 (SIL, cffi) and the Cortex-M4F (PIL). Nothing from the fast-math family and no
+# tuning for the build machine (SPEC section 5): both targets must round exactly alike.
 COMMON = [
     "-std=c99", "-pedantic", "-O2",
     "-ffp-contract=off", "-fno-math-errno", "-fexcess-precision=standard",
