@@ -63,7 +63,7 @@ def controller_context(a: Artifact, cfg: cs.ControllerConfig, name: str) -> dict
         "creator": str(a.metadata.get("creator", "")),
         "status_pid": cs.STATUS_PID, "status_bounds_mask": cs.STATUS_BOUNDS_MASK,
         "status_invalid": cs.STATUS_INPUT_INVALID, "status_saturated": cs.STATUS_SATURATED,
-        "status_dwell": cs.STATUS_DWELL, "status_state_repaired": cs.STATUS_STATE_REPAIRED,
+        "status_dwell": cs.STATUS_DWELL, "lat_bam_max": cs.LAT_BAM_MAX, "status_state_repaired": cs.STATUS_STATE_REPAIRED,
         "status_bound_shift": cs.STATUS_BOUND_SHIFT,
         "utc_ms_max": cs.UTC_MS_MAX, "utc_day_min": cs.UTC_DAY_MIN, "utc_day_max": cs.UTC_DAY_MAX,
         "gmst_a": _c_u64(cs.GMST_A), "gmst_b": _c_u64(cs.GMST_B), "gmst_q": _c_u64(cs.GMST_Q),

@@ -22,6 +22,10 @@ STATUS_BOUNDS_MASK = ((1 << N_BOUNDS) - 1) << STATUS_BOUND_SHIFT
 
 MODE_NN, MODE_PID = 0, 1
 
+# Target latitude as a binary angle (LSB = pi * 2^-31 rad): |lat| <= 2^30 is [-90, 90] deg; beyond
+# it the geometry would silently aim at the mirrored latitude, so it is an invalid input.
+LAT_BAM_MAX = 1 << 30
+
 # ----------------------------------------------------------------------------- time base
 # UTC on board: utc_day = days since 2000-01-01 (= Julian Day Number - 2451545, the JDN of that
 # date) and utc_ms = milliseconds since that day's UTC midnight (86,400,000 + 1,000 for a leap second).

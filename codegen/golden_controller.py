@@ -167,10 +167,10 @@ def _is_finite(v: np.ndarray) -> np.ndarray:
     return (v - v) == _f(0.0)
 
 
-def pid(cfg: cs.ControllerConfig, integral: np.ndarray, x: np.ndarray, time_ok: np.ndarray):
+def pid(cfg: cs.ControllerConfig, integral: np.ndarray, x: np.ndarray, geometry_ok: np.ndarray):
     """controller_pid: (raw command, new integrator), both (N, 3)."""
     zero = _f(0.0)
-    keep = np.where(time_ok, _f(1.0), zero)[:, None]
+    keep = np.where(geometry_ok, _f(1.0), zero)[:, None]
     a = np.where(_is_finite(x[:, 6:9]), x[:, 6:9] * keep, zero)
     w = np.where(_is_finite(x[:, 9:12]), x[:, 9:12] * keep, zero)
     kp, ki, kd = (np.array(v, dtype=F32) for v in (cfg.kp, cfg.ki, cfg.kd))
@@ -229,7 +229,8 @@ def step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndarr
 def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndarray):
     day, ms = inp["utc_day"], inp["utc_ms"]
     time_ok = (ms >= 0) & (ms < cs.UTC_MS_MAX) & (day >= cs.UTC_DAY_MIN) & (day <= cs.UTC_DAY_MAX)
-    valid = _inputs_finite(inp) & time_ok
+    geometry_ok = time_ok & (inp["lat"] >= -cs.LAT_BAM_MAX) & (inp["lat"] <= cs.LAT_BAM_MAX)
+    valid = _inputs_finite(inp) & geometry_ok
     g = gmst_turns(np.where(time_ok, day, 0), np.where(time_ok, ms, 0))
     R = tuple(np.ascontiguousarray(inp["R_s"][:, i]) for i in range(3))
     V = tuple(np.ascontiguousarray(inp["V_s"][:, i]) for i in range(3))
@@ -248,7 +249,7 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
         status |= np.where(inside[:, i], U32(0), U32(1 << (cs.STATUS_BOUND_SHIFT + i)))
     status |= np.where(valid, U32(0), U32(cs.STATUS_INPUT_INVALID))
     integral, repaired = repair_integral(cfg, state["integral"])
-    raw, integral = pid(cfg, integral, x, time_ok)
+    raw, integral = pid(cfg, integral, x, geometry_ok)
     mode, count = update_mode(cfg, state["mode"], state["clean"], status == 0)
     nn = mode == U32(0)
     y = golden.network_eval(a, np.ascontiguousarray(x))

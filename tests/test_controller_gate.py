@@ -76,6 +76,25 @@ def test_corrupted_integrator_is_repaired_and_flagged(artifact, cfg, vectors):
     assert not np.any(healthy["status"] & cs.STATUS_STATE_REPAIRED)
 
 
+def test_latitude_beyond_90_degrees_is_an_invalid_input(artifact, cfg, vectors):
+    """lat outside [-2^30, 2^30] (binary angle) would aim at the mirrored latitude: refused."""
+    _, inputs, kind = vectors
+    rows = np.flatnonzero(kind == 0)[:8]
+    inp = inputs[rows].copy()
+    inp["lat"] = np.where(np.arange(rows.size) % 2 == 0, cs.LAT_BAM_MAX + 1, -cs.LAT_BAM_MAX - 1)
+    states = gc.init(rows.size)
+    g_out, g_state = gc.step(artifact, cfg, states, inp)
+    assert np.all(g_out["status"] & cs.STATUS_INPUT_INVALID) and np.all(g_out["status"] & cs.STATUS_PID)
+    assert np.all(g_out["torque"] == 0.0)  # Table 1 PID on zeroed errors (Ki = 0)
+    for out, st in (X86Controller(artifact, cfg).run_records(states, inp),
+                    gate.ArmRunner(artifact, cfg).run_records(states, inp)):
+        assert gate.compare_outputs(g_out, out) == [] and gate.compare_states(g_state, st) == []
+    # exactly +-90 deg is a valid latitude
+    inp["lat"] = np.where(np.arange(rows.size) % 2 == 0, cs.LAT_BAM_MAX, -cs.LAT_BAM_MAX)
+    edge, _ = gc.step(artifact, cfg, states, inp)
+    assert not np.any(edge["status"] & cs.STATUS_INPUT_INVALID)
+
+
 def test_three_way_gate_sequences_with_mode_switches(artifact, cfg):
     seqs = gate.sequence_inputs(N_SEQ, SEQ_STEPS, seed=5)
     g = gc.run_sequences(artifact, cfg, seqs)
