@@ -43,15 +43,19 @@ def normalise(a: Artifact, x: np.ndarray) -> np.ndarray:
         return _f32(scaled + np.float32(m.ymin), "normalise add")
 
 
-def hidden_preactivation(a: Artifact, xn: np.ndarray) -> np.ndarray:
-    """acc[:, j] = b1[j], then acc + W1[j][i] * xn[i] for i in order; (N, n_in) -> (N, n_hidden)."""
-    xn = _f32(_batch(xn, a.n_in, "xn"), "mlp input")
-    W1 = _f32(a.W1, "W1")
-    acc = np.repeat(_f32(a.b1, "b1")[None, :], xn.shape[0], axis=0)
+def sequential_affine(W: np.ndarray, b: np.ndarray, v: np.ndarray, what: str) -> np.ndarray:
+    """acc[:, r] = b[r], then acc + W[r][c] * v[c] for c in order — the C's accumulation order."""
+    W = _f32(W, f"{what} W")
+    acc = np.repeat(_f32(b, f"{what} b")[None, :], v.shape[0], axis=0)
     with np.errstate(all="ignore"):
-        for i in range(a.n_in):
-            acc = _f32(acc + _f32(W1[:, i] * xn[:, i, None], "W1*x"), "hidden accumulate")
+        for c in range(W.shape[1]):
+            acc = _f32(acc + _f32(W[:, c] * v[:, c, None], f"{what} W*v"), f"{what} accumulate")
     return acc
+
+
+def hidden_preactivation(a: Artifact, xn: np.ndarray) -> np.ndarray:
+    """b1 + W1 xn accumulated sequentially; (N, n_in) -> (N, n_hidden)."""
+    return sequential_affine(a.W1, a.b1, _f32(_batch(xn, a.n_in, "xn"), "mlp input"), "hidden")
 
 
 def tansig(acc: np.ndarray) -> np.ndarray:
@@ -60,14 +64,8 @@ def tansig(acc: np.ndarray) -> np.ndarray:
 
 
 def output_layer(a: Artifact, h: np.ndarray) -> np.ndarray:
-    """yn[:, k] = b2[k], then yn + W2[k][j] * h[j] for j in order; (N, n_hidden) -> (N, n_out)."""
-    h = _f32(_batch(h, a.n_hidden, "h"), "output input")
-    W2 = _f32(a.W2, "W2")
-    acc = np.repeat(_f32(a.b2, "b2")[None, :], h.shape[0], axis=0)
-    with np.errstate(all="ignore"):
-        for j in range(a.n_hidden):
-            acc = _f32(acc + _f32(W2[:, j] * h[:, j, None], "W2*h"), "output accumulate")
-    return acc
+    """b2 + W2 h accumulated sequentially; (N, n_hidden) -> (N, n_out)."""
+    return sequential_affine(a.W2, a.b2, _f32(_batch(h, a.n_hidden, "h"), "output input"), "output")
 
 
 def mlp(a: Artifact, xn: np.ndarray) -> np.ndarray:

@@ -441,10 +441,8 @@ def test_powf_fused_twin_equals_c(clib):
     assert not bad.any(), x8[bad][:5]
 
 
-def test_powf_fused_sampled_ulp_bound():
-    """Fast path: error <= POWF_FUSED_ULP_BASE + POWF_FUSED_ULP_PER_Y |y| ulp on 1.2e6 samples
-    (docs/math.md); y = 0.8 (the tanh law's gamma) within 1.7 ulp on (1e-8, 1e4]."""
-    rng = np.random.default_rng(22)
+def pow_fast_path_samples(rng):
+    """(x, y, float64 x**y) for x over all positive normals, |y| <= 4, |y log2 x| < 124 (fast path)."""
     x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
     y = (rng.uniform(-4, 4, x.size) * np.minimum(1.0, 120.0 / np.maximum(np.abs(np.log2(x.astype(np.float64))), 1.0)))
     y = y.astype(F32)
@@ -453,6 +451,14 @@ def test_powf_fused_sampled_ulp_bound():
     ok = np.abs(t) < 124.0
     x, y = x[ok], y[ok]
     ref = np.power(x.astype(np.float64), y.astype(np.float64))
+    return x, y, ref
+
+
+def test_powf_fused_sampled_ulp_bound():
+    """Fast path: error <= POWF_FUSED_ULP_BASE + POWF_FUSED_ULP_PER_Y |y| ulp on 1.2e6 samples
+    (docs/math.md); y = 0.8 (the tanh law's gamma) within 1.7 ulp on (1e-8, 1e4]."""
+    rng = np.random.default_rng(22)
+    x, y, ref = pow_fast_path_samples(rng)
     err = ulp_error(dm.powf_fused(x, y), ref)
     bound = dm.POWF_FUSED_ULP_BASE + dm.POWF_FUSED_ULP_PER_Y * np.abs(y.astype(np.float64))
     assert (err <= bound).all(), (err[err > bound][:3], x[err > bound][:3], y[err > bound][:3])
@@ -515,14 +521,7 @@ def test_powf_tab_sampled_ulp_bound():
     """Fast path: error <= POWF_TAB_ULP_BASE + POWF_TAB_ULP_PER_Y |y| ulp on 1e6 samples
     (docs/math.md); the tanh law's exponents (0.8, -0.2) within 1.4 ulp on (1e-8, 1e4]."""
     rng = np.random.default_rng(32)
-    x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
-    y = (rng.uniform(-4, 4, x.size) * np.minimum(1.0, 120.0 / np.maximum(np.abs(np.log2(x.astype(np.float64))), 1.0)))
-    y = y.astype(F32)
-    with np.errstate(all="ignore"):
-        t = y.astype(np.float64) * np.log2(x.astype(np.float64))
-    ok = np.abs(t) < 124.0
-    x, y = x[ok], y[ok]
-    ref = np.power(x.astype(np.float64), y.astype(np.float64))
+    x, y, ref = pow_fast_path_samples(rng)
     err = ulp_error(dm.powf_tab(x, y), ref)
     bound = dm.POWF_TAB_ULP_BASE + dm.POWF_TAB_ULP_PER_Y * np.abs(y.astype(np.float64))
     assert (err <= bound).all(), (err[err > bound][:3], x[err > bound][:3], y[err > bound][:3])

@@ -153,12 +153,17 @@ def run_network(args: argparse.Namespace, modes) -> int:
     name = "network"
     entry, facts = network_report(a, name, modes, args.per_class, args.seed)
     lines = text_report(name, entry, facts, modes)
+    return publish(args, name, entry, lines, f"{args.artifact} ({a.shape_text})")
+
+
+def publish(args: argparse.Namespace, entry_name: str, entry: dict, lines: list[str], title: str) -> int:
+    """Print the report; write it as JSON ({"entries": {name: entry}}) and Markdown when asked."""
     print("\n".join(lines))
     if args.json:
-        atomic.write_json(args.json, {"entries": {name: entry}})
+        atomic.write_json(args.json, {"entries": {entry_name: entry}})
         print(f"wrote {args.json}")
     if args.md:
-        atomic.write_text(args.md, f"# Cycle report: {args.artifact} ({a.shape_text})\n\n" + "\n".join(lines) + "\n")
+        atomic.write_text(args.md, f"# Cycle report: {title}\n\n" + "\n".join(lines) + "\n")
         print(f"wrote {args.md}")
     return 0
 
@@ -174,14 +179,7 @@ def run_tanh(args: argparse.Namespace, modes) -> int:
         raise HostError(f"--period must be a positive number of seconds, got {args.period}")
     rep = tanh_sil.cycle_report(load_params(args.params), args.period, modes, args.per_class, args.seed)
     lines = tanh_sil.cycle_text(rep)
-    print("\n".join(lines))
-    if args.json:
-        atomic.write_json(args.json, {"entries": {"tanh": rep}})
-        print(f"wrote {args.json}")
-    if args.md:
-        atomic.write_text(args.md, f"# Cycle report: tanh law, {args.params}\n\n" + "\n".join(lines) + "\n")
-        print(f"wrote {args.md}")
-    return 0
+    return publish(args, "tanh", rep, lines, f"tanh law, {args.params}")
 
 
 def run_controller(args: argparse.Namespace, modes) -> int:
@@ -192,15 +190,7 @@ def run_controller(args: argparse.Namespace, modes) -> int:
     a = load_artifact(args.artifact)   # None: the stand-in network fitted to the PID law
     rep = controller_cycles.cycle_report(a, flight_config(), modes, args.per_class, args.seed)
     lines = controller_cycles.cycle_text(rep)
-    print("\n".join(lines))
-    if args.json:
-        atomic.write_json(args.json, {"entries": {"controller": rep}})
-        print(f"wrote {args.json}")
-    if args.md:
-        atomic.write_text(args.md, f"# Cycle report: controller step, {args.artifact or 'stand-in network'}\n\n"
-                          + "\n".join(lines) + "\n")
-        print(f"wrote {args.md}")
-    return 0
+    return publish(args, "controller", rep, lines, f"controller step, {args.artifact or 'stand-in network'}")
 
 
 # Entry points the report knows: name -> handler(args, modes).
