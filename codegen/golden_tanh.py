@@ -112,7 +112,10 @@ def compensation(k: Constants32, delta, dsq):
 def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     """(u, vdot, x2) of law (10)-(20), as {name}_nominal."""
     inv_q0 = F32(4.0) * k_e
-    kk = F32(2.0) / (q0 * q0 + nsq)
+    m = q0 * q0 + nsq
+    rr = F32(1.0) / (m * om)  # one division for both 2/m and 1/om
+    kk = (F32(2.0) * om) * rr
+    inv_om = m * rr
     barrier = k.lam * detmath.logf_tab(om)
     fs = [shaping(k, x1[i]) for i in range(3)]
     g = _v(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
@@ -121,7 +124,7 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     x1_dot = e_apply(q0, x1, w_e)
     q0_dot = F32(-0.5) * dot(x1, w_e)
     e_dot_w = e_apply(q0_dot, x1_dot, w_ev)
-    radial = (k.nlam2 * dot(x1, x1_dot)) / om
+    radial = (k.nlam2 * dot(x1, x1_dot)) * inv_om
     dg = _v(*(((k.nbeta1 - k.beta2 * fs[i][1]) + barrier) * x1_dot[i] + radial * x1[i] for i in range(3)))
     dg = _v(*(dg[i] - e_dot_w[i] for i in range(3)))
     w_ev_dot = e_solve(q0, inv_q0, kk, x1, dg)
@@ -167,7 +170,7 @@ def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
     re = error_matrix(rt, rc)
     rw = mat_t_vec(re, w_t)
     w_e = _v(*(w_c[i] - rw[i] for i in range(3)))
-    inputs_ok = np.all(np.isfinite(np.stack(re + w_e + wdot_t)), axis=0)
+    inputs_ok = sum_is_finite(re + w_e + wdot_t)
     tr = (re[0] + re[4]) + re[8]
     opt = F32(1.0) + tr
     upper = opt > k.q0min_sq4
@@ -187,15 +190,20 @@ def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
             pick(x2_n, (zero, zero, zero)), status, inputs_ok)
 
 
-def _finite_rows(a: np.ndarray) -> np.ndarray:
-    return np.all(np.isfinite(a), axis=1)
+def sum_is_finite(values) -> np.ndarray:
+    """The C's validity test: the float32 sum of the values, left to right, is finite (every value
+    finite and no overflow); s - s == 0 exactly when s is finite."""
+    acc = values[0]
+    for v in values[1:]:
+        acc = _f32(acc + v, "sum")
+    return (acc - acc) == F32(0.0)
 
 
 def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """One {name}_step on N independent (state, input) rows: (new state (N, 3), output (N, 13))."""
     state, inputs = _records(state, N_STATE, "state"), _records(inputs, N_IN, "inputs")
     with np.errstate(all="ignore"):
-        state_ok = _finite_rows(state)
+        state_ok = sum_is_finite(tuple(state[:, j] for j in range(3)))
         col = lambda a, j: np.ascontiguousarray(a[:, j])  # noqa: E731
         vec = lambda name: tuple(col(inputs, j) for j in range(FIELDS[name].start, FIELDS[name].stop))  # noqa: E731
         varpi = tuple(col(state, j) for j in range(3))
@@ -203,7 +211,7 @@ def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndar
                                                  vec("wdot_t"))
         ok = state_ok & inputs_ok
         zero = np.zeros(state.shape[0], dtype=F32)
-        result_ok = np.all(np.isfinite(np.stack(u + vdot)), axis=0)
+        result_ok = sum_is_finite(u + vdot)
         keep = ok & result_ok
         u = tuple(np.where(keep, c, zero) for c in u)
         vdot = tuple(np.where(keep, c, zero) for c in vdot)
