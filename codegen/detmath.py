@@ -490,19 +490,23 @@ def powc_tables(y) -> PowC:
 
 
 def powc_c_initializer(t: PowC, indent: str = "    ") -> str:
-    """The C initializer of an sg_powc_t (hex-float literals, 8 per line)."""
+    """The C initializer of an sg_powc_t (hex-float literals): y, p, the 32 interval rows {c_i, 1/c_i,
+    c_i^y, 0} (c_i, 1/c_i those of sg_powf_tab_log) and 2^(y k), 8 per line."""
     from codegen.emit import c_float as _c_hex  # the one float32 -> exact C literal (keeps -0, refuses NaN)
 
     def rows(a):
         return (",\n" + indent * 2).join(", ".join(_c_hex(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
+    interval_rows = (",\n" + indent * 2).join(
+        "{" + ", ".join(_c_hex(v) for v in (F32(c), F32(ic), cy, F32(0.0))) + "}"
+        for (c, ic, _log2c), cy in zip(_PT_LOG, t.cy))
     return ("{\n" + indent + _c_hex(t.y) + ",\n" + indent + "{" + ", ".join(_c_hex(v) for v in t.p) + "},\n"
-            + indent + "{\n" + indent * 2 + rows(t.cy) + "\n" + indent + "},\n"
+            + indent + "{\n" + indent * 2 + interval_rows + "\n" + indent + "},\n"
             + indent + "{\n" + indent * 2 + rows(t.ek) + "\n" + indent + "}\n}")
 
 
 def powf_const(x, t: PowC) -> np.ndarray:
     """Mirror of sg_powf_const (sg_math.h): x^y from the tables t = powc_tables(y) for x positive
-    normal; otherwise powf_pos(x, y)."""
+    normal; +0 for x = +0 or subnormal when y > 0; otherwise powf_pos(x, y)."""
     x = _f32(x)
     with np.errstate(all="ignore"):
         bx = _as_u32(x)
@@ -517,7 +521,8 @@ def powf_const(x, t: PowC) -> np.ndarray:
         q = r * (((p3 * r + p2) * r + p1) * r + p0)
         s = t.cy[i] * t.ek[kk]
         res = s + s * q
-        out = np.where(fast, res, powf_pos(x, t.y))
+        flush = (bx < U32(0x00800000)) & (t.y > F32(0.0))  # +0 and subnormal x, y > 0: +0
+        out = np.where(fast, res, np.where(flush, F32(0.0), powf_pos(x, t.y)))
     return _check(np.asarray(out, dtype=F32))
 
 

@@ -559,7 +559,8 @@ def test_powf_const_twin_equals_c(clib):
 
 def test_powf_const_sampled_ulp_bound():
     """Error <= POWC_ULP ulp on 1e6 positive normals (log-uniform) per exponent; edge cases:
-    x not a positive normal takes powf_pos (1^y is not exact: c_i != 1)."""
+    +0 and subnormal x give +0 when y > 0 (no call; the true value is below 2^(-126 y)), every
+    other x that is not a positive normal takes powf_pos (1^y is not exact: c_i != 1)."""
     rng = np.random.default_rng(42)
     x = np.exp2(rng.uniform(-126, 128, 1_000_000)).astype(F32)
     for y in [*POWC_YS.values(), 0.1, -0.6]:
@@ -567,8 +568,13 @@ def test_powf_const_sampled_ulp_bound():
         err = ulp_error(dm.powf_const(x, t), np.power(x.astype(np.float64), float(t.y)))
         assert err.max() <= dm.POWC_ULP, (y, err.max())
     t = dm.powc_tables(0.8)
-    for xs in (0.0, -0.0, -2.0, np.inf, np.nan, 2.0**-130):
+    for xs in (-0.0, -2.0, -(2.0**-130), np.inf, np.nan):
         assert same(np.asarray(dm.powf_const(xs, t), F32), np.asarray(dm.powf_pos(xs, t.y), F32))
+    tiny = np.array([0.0, 2.0**-149, 2.0**-130, np.nextafter(F32(2.0**-126), F32(0))], F32)
+    assert np.array_equal(dm.powf_const(tiny, t).view(np.uint32), np.zeros(4, np.uint32))
+    assert np.all(np.power(tiny.astype(np.float64), float(t.y)) < 2.0 ** (-126 * 0.8))
+    t_neg = dm.powc_tables(-0.2)  # y < 0: 0 and subnormals keep powf_pos (+Inf at 0, finite above)
+    assert np.array_equal(dm.powf_const(tiny, t_neg).view(np.uint32), dm.powf_pos(tiny, t_neg.y).view(np.uint32))
     with pytest.raises(ValueError):
         dm.powc_tables(1.0)
     assert np.isfinite(dm.powc_tables(1.0 - 2.0**-24).ek).all()

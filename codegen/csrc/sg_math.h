@@ -38,6 +38,14 @@ float sg_tanhf(float x);
 #else
 #define SG_LOADS_DONE() ((void)0)
 #endif
+/* The same for constants that GCC would otherwise reload from the literal pool one by one next
+ * to each use: the empty asm takes them in FPU registers, so their loads are issued together
+ * before it (ARM hard-float only; no instruction, no effect on results). */
+#if defined(__GNUC__) && defined(__arm__) && defined(__VFP_FP__) && !defined(__SOFTFP__)
+#define SG_IN_REGS4(a, b, c, d) __asm__("" : "+t"(a), "+t"(b), "+t"(c), "+t"(d))
+#else
+#define SG_IN_REGS4(a, b, c, d) ((void)0)
+#endif
 
 /* ---- sg_inline_tanhf: sg_tanhf for a hot loop ------------------------------------------
  * The same function bit for bit (both use sg_tanh_index and sg_tanh_poly below), as a static
@@ -284,14 +292,16 @@ static SG_ALWAYS_INLINE float sg_powf_tab(float x, float y)
  * p0 = y; truncation <= 5e-11 relative): c_i^y and 2^(y k) are float32 table entries (32 and
  * 255), so there is no exp2 at all and no range test (|y| <= 31/32 keeps every result normal;
  * closer to 1 the table's ends are clamped to the float32 range).
- * x not a positive normal float (0, subnormal, negative, +Inf, NaN): sg_powf_pos(x, y).
+ * y > 0 and x = +0 or subnormal: +0, without a call (the true value is below 2^(-126 y); so a
+ * caller whose x is never negative, infinite or NaN has no slow path at all). Any other x not a
+ * positive normal float (-0, negative, +Inf, NaN; 0 and subnormals when y < 0): sg_powf_pos(x, y).
  * Error and cycles: docs/math.md. */
 #define SG_POWC_NK 255u /* k = -126 .. 128 */
 typedef struct {
-    float y;                 /* the exponent */
-    float p[4];              /* p0 .. p3 */
-    float cy[SG_POWF_TAB_N]; /* c_i^y */
-    float ek[SG_POWC_NK];    /* 2^(y k), k = -126 .. 128 */
+    float y;                     /* the exponent */
+    float p[4];                  /* p0 .. p3 */
+    float row[SG_POWF_TAB_N][4]; /* c_i, 1/c_i, c_i^y, 0: one address for the three loads */
+    float ek[SG_POWC_NK];        /* 2^(y k), k = -126 .. 128 */
 } sg_powc_t;
 
 static SG_ALWAYS_INLINE float sg_powf_const(float x, const sg_powc_t *t)
@@ -302,15 +312,20 @@ static SG_ALWAYS_INLINE float sg_powf_const(float x, const sg_powc_t *t)
     const float *row;
     bx.f = x;
     if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
-        return sg_powf_pos(x, t->y); /* not a positive normal finite float */
+        if (t->y > 0.0f && bx.u < 0x00800000u) {
+            return 0.0f; /* +0 or subnormal x, y > 0: +0 (exact at 0, below 2^(-126 y) otherwise) */
+        }
+        return sg_powf_pos(x, t->y); /* -0, negative, +Inf, NaN; y < 0 at +0 or subnormal x */
     }
     ix = bx.u + (0x3f800000u - 0x3f330000u);
-    row = sg_powf_tab_log[(ix >> 18) & 31u];
-    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+    row = t->row[(ix >> 18) & 31u];
+    /* (ix & 0x7fffff) + 0x3f330000, written so that the constant is one Thumb-2 immediate */
+    bx.u = (bx.u + 0x3f800000u) - ((ix >> 23) << 23);
     z = bx.f;
     {
-        const float c = row[0], ic = row[1], cy = t->cy[(ix >> 18) & 31u], ek = t->ek[(ix >> 23) - 1u];
-        const float p0 = t->p[0], p1 = t->p[1], p2 = t->p[2], p3 = t->p[3];
+        const float c = row[0], ic = row[1], cy = row[2], ek = t->ek[(ix >> 23) - 1u];
+        float p0 = t->p[0], p1 = t->p[1], p2 = t->p[2], p3 = t->p[3];
+        SG_IN_REGS4(p0, p1, p2, p3); /* the four coefficient loads issued together */
         SG_LOADS_DONE();
         r = (z - c) * ic;
         q = r * (((p3 * r + p2) * r + p1) * r + p0);
