@@ -33,8 +33,26 @@ from firmware.flags import COMMON
 
 X86_CC = "gcc"
 X86_FLAGS = [*COMMON, "-fPIC"]
-# Bump when the layout of a cache folder changes.
-BUILD_LAYOUT = "1"
+# Bump when the layout of a cache folder changes (2: every module carries the host helpers below).
+BUILD_LAYOUT = "2"
+
+# Host helpers appended to every cffi wrapper (never to the flight sources, which stay free of
+# intrinsics): read the SSE control register so a batch can refuse to run when something else in
+# this process set flush-to-zero, denormals-are-zero or a directed rounding mode (the golden model
+# assumes IEEE defaults). The setter exists for the tests only.
+HOST_CDEF = """
+unsigned int sg_host_mxcsr(void);
+void sg_host_set_mxcsr(unsigned int value);
+"""
+HOST_HARNESS = """
+#include <xmmintrin.h>
+static unsigned int sg_host_mxcsr(void) { return _mm_getcsr(); }
+static void sg_host_set_mxcsr(unsigned int value) { _mm_setcsr(value); }
+"""
+MXCSR_DAZ = 1 << 6
+MXCSR_FTZ = 1 << 15
+MXCSR_RC = 3 << 13  # rounding control; 00 = round to nearest even
+_ROUNDING = {1: "round-down", 2: "round-up", 3: "round-toward-zero"}
 
 _loaded: dict[str, "X86Build"] = {}
 
@@ -55,6 +73,23 @@ class X86Build:
     @property
     def sources(self) -> Path:
         return self.folder / "src"
+
+    def check_fp_environment(self) -> None:
+        """Raise FirmwareError if this thread's MXCSR is not the IEEE default the golden model
+        assumes. MXCSR can be changed at any time by another library (e.g. one built with
+        -ffast-math), so batch entry points call this before each call into the flight code."""
+        csr = int(self.lib.sg_host_mxcsr())
+        bad = []
+        if csr & MXCSR_FTZ:
+            bad.append("flush-to-zero (FTZ)")
+        if csr & MXCSR_DAZ:
+            bad.append("denormals-are-zero (DAZ)")
+        if csr & MXCSR_RC:
+            bad.append(f"rounding mode {_ROUNDING[(csr & MXCSR_RC) >> 13]}")
+        if bad:
+            raise FirmwareError(
+                f"x86 SIL: MXCSR 0x{csr:04x} has {', '.join(bad)} set: subnormal or rounded results would "
+                "differ from the golden model; something in this process changed the SSE control register")
 
 
 def cache_root() -> Path:
@@ -77,7 +112,7 @@ def build_key(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86
     parts = {
         "layout": BUILD_LAYOUT, "flags": X86_FLAGS, "cc": compiler_version(cc),
         "abi": sysconfig.get_config_var("EXT_SUFFIX"), "python": sys.version.split()[0],
-        "cffi": cffi.__version__, "cdef": cdef, "harness": harness,
+        "cffi": cffi.__version__, "cdef": cdef, "harness": harness, "host": HOST_CDEF + HOST_HARNESS,
         "sources": sorted(sources.items()),
     }
     h.update(json.dumps(parts, sort_keys=True).encode("utf-8"))
@@ -136,8 +171,8 @@ def _build_into(folder: Path, key: str, sources: Mapping[str, str], cdef: str, h
         (src / fname).write_text(text, encoding="utf-8")
     objects = compile_objects(src, folder / "obj", cc)
     ffi = cffi.FFI()
-    ffi.cdef(cdef)
-    ffi.set_source(_module_name(key), harness, include_dirs=[str(src)],
+    ffi.cdef(cdef + HOST_CDEF)
+    ffi.set_source(_module_name(key), harness + HOST_HARNESS, include_dirs=[str(src)],
                    extra_objects=[str(o) for o in objects])
     log = folder / "build.log"
     try:
@@ -190,6 +225,7 @@ def build(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC)
 
     sources: {file name: text} (headers and .c files, flight code); cdef: the declarations
     exposed to Python; harness: extra C placed in the cffi wrapper (includes, batch loops).
+    HOST_CDEF / HOST_HARNESS are appended to both (see X86Build.check_fp_environment).
     """
     key = build_key(sources, cdef, harness, cc)
     if key in _loaded:
@@ -255,6 +291,7 @@ class X86Network:
         if x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != n_in:
             raise ValueError(f"x86 {stage}: expected float32 of shape (N, {n_in}), got {x.dtype} {x.shape}")
         y = np.empty((x.shape[0], n_out), dtype=np.float32)
+        self.build.check_fp_environment()
         ffi = self.build.ffi
         fn = getattr(self.build.lib, f"{self.name}_{stage}_batch")
         fn(ffi.cast("const float *", ffi.from_buffer(x)), ffi.cast("float *", ffi.from_buffer(y)), x.shape[0])

@@ -81,6 +81,7 @@ class X86Controller:
         rec = np.zeros(inputs.shape, dtype=RECORD_IN_DTYPE)
         rec["state"], rec["input"] = states, inputs
         out = np.zeros(inputs.shape, dtype=RECORD_OUT_DTYPE)
+        self.build.check_fp_environment()
         getattr(self.lib, f"{self.name}_run_records")(self._ptr(rec, "void *"), self._ptr(out, "void *"), rec.size)
         return out["output"].copy(), out["state"].copy()
 
@@ -88,6 +89,7 @@ class X86Controller:
         """Rows as consecutive steps from the current state (carried on)."""
         inputs = np.ascontiguousarray(inputs, dtype=INPUT_DTYPE)
         out = np.zeros(inputs.shape, dtype=OUTPUT_DTYPE)
+        self.build.check_fp_environment()
         getattr(self.lib, f"{self.name}_run_sequence")(
             self.state, self._ptr(inputs, f"{self.name}_input_t *"), self._ptr(out, f"{self.name}_output_t *"),
             inputs.size)

@@ -135,6 +135,7 @@ class X86Tanh:
         """Independent rows: state (N, 3), inputs (N, 27) -> outputs (N, 13)."""
         state, inputs = _rows(state, gt.N_STATE, "state"), _rows(inputs, gt.N_IN, "inputs")
         out = np.empty((inputs.shape[0], gt.N_OUT), dtype=F32)
+        self.build.check_fp_environment()
         getattr(self.build.lib, f"{self.name}_step_batch")(
             self._ptr(state, "const float *"), self._ptr(inputs, "const float *"), self._ptr(out, "float *"),
             inputs.shape[0])
@@ -144,6 +145,7 @@ class X86Tanh:
         """One time series from tanh_init: inputs (T, 27) -> outputs (T, 13)."""
         inputs = _rows(inputs, gt.N_IN, "inputs")
         out = np.empty((inputs.shape[0], gt.N_OUT), dtype=F32)
+        self.build.check_fp_environment()
         getattr(self.build.lib, f"{self.name}_run_sequence")(
             self._ptr(inputs, "const float *"), self._ptr(out, "float *"), inputs.shape[0])
         return out
@@ -205,6 +207,7 @@ class _SilController:
     def step(self, record: np.ndarray) -> np.ndarray:
         x = self.ffi.new(f"{self.name}_input_t *")
         self.ffi.memmove(x, record.tobytes(), gt.N_IN * 4)
+        self.x86.build.check_fp_environment()  # one cffi call: negligible next to the step's
         self._step(self.state, x, self.out)
         return np.frombuffer(self.ffi.buffer(self.out), dtype=F32).copy()
 
