@@ -77,7 +77,7 @@ class X86Build:
     def check_fp_environment(self) -> None:
         """Raise FirmwareError if this thread's MXCSR is not the IEEE default the golden model
         assumes. MXCSR can be changed at any time by another library (e.g. one built with
-        -ffast-math), so batch entry points call this before each call into the flight code."""
+        fast-math options), so batch entry points call this before each call into the flight code."""
         csr = int(self.lib.sg_host_mxcsr())
         bad = []
         if csr & MXCSR_FTZ:

@@ -19,9 +19,7 @@ N_STEPS = 4000
 N_SEQ, SEQ_STEPS = 3, 1000
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+pytestmark = pytest.mark.usefixtures("private_cache")  # conftest: a build cache of its own
 
 
 @pytest.fixture(scope="module")

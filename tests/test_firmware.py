@@ -19,9 +19,7 @@ from tools.m4.machine import SCB_CPACR, Machine
 from unicorn import arm_const as R
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+pytestmark = pytest.mark.usefixtures("private_cache")  # conftest: a build cache of its own
 
 
 @pytest.fixture(scope="module")

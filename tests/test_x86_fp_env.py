@@ -20,9 +20,7 @@ from host.tanh_sil import X86Tanh
 CONTROL = 0xFFC0  # MXCSR control bits; bits 0-5 are sticky exception flags that float code sets
 
 
-@pytest.fixture(autouse=True)
-def private_cache(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path_factory.getbasetemp() / "cache"))
+pytestmark = pytest.mark.usefixtures("private_cache")  # conftest: a build cache of its own
 
 
 @pytest.fixture(scope="module")
