@@ -17,6 +17,7 @@ import numpy as np
 from codegen import controller_spec as cs
 from codegen import detmath as dm
 from codegen import golden
+from codegen.golden_vec3 import v_add, v_cross, v_dot, v_scale, v_sub
 from codegen.artifact import Artifact
 from codegen.controller_emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, TURN32_HI, TURN32_LO, envelope_bounds
 
@@ -30,28 +31,6 @@ def _f(v) -> np.float32:
 def _chk(a: np.ndarray) -> np.ndarray:
     assert a.dtype == F32, a.dtype
     return a
-
-
-# ----------------------------------------------------------------------------- vec3 helpers
-
-def v_add(a, b):
-    return tuple(_chk(p + q) for p, q in zip(a, b))
-
-
-def v_sub(a, b):
-    return tuple(_chk(p - q) for p, q in zip(a, b))
-
-
-def v_scale(a, s):
-    return tuple(_chk(p * s) for p in a)
-
-
-def v_dot(a, b):
-    return _chk((a[0] * b[0] + a[1] * b[1]) + a[2] * b[2])
-
-
-def v_cross(a, b):
-    return (_chk(a[1] * b[2] - a[2] * b[1]), _chk(a[2] * b[0] - a[0] * b[2]), _chk(a[0] * b[1] - a[1] * b[0]))
 
 
 def unit_derivs(w, w1, w2):

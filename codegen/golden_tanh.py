@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from codegen import detmath
+from codegen.golden_vec3 import f32, v3, v_cross, v_dot, v_sub
 from codegen.tanh_emit import Constants32
 
 F32 = np.float32
@@ -32,48 +33,31 @@ OUT_FIELDS = {"torque": slice(0, 3), "x1": slice(3, 6), "x2": slice(6, 9), "varp
               "status": slice(12, 13)}
 
 
-def _f32(a, what: str = "stage"):
-    assert a.dtype == F32, f"golden_tanh {what}: expected float32, got {a.dtype}"
-    return a
-
-
-def _v(*parts):
-    return tuple(_f32(p) for p in parts)
-
-
-def dot(a, b):
-    return _f32((a[0] * b[0] + a[1] * b[1]) + a[2] * b[2], "dot")
-
-
-def cross(a, b):
-    return _v(a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
 def mat_vec(m, v):
-    return _v((m[0] * v[0] + m[1] * v[1]) + m[2] * v[2], (m[3] * v[0] + m[4] * v[1]) + m[5] * v[2],
+    return v3((m[0] * v[0] + m[1] * v[1]) + m[2] * v[2], (m[3] * v[0] + m[4] * v[1]) + m[5] * v[2],
               (m[6] * v[0] + m[7] * v[1]) + m[8] * v[2])
 
 
 def mat_t_vec(m, v):
-    return _v((m[0] * v[0] + m[3] * v[1]) + m[6] * v[2], (m[1] * v[0] + m[4] * v[1]) + m[7] * v[2],
+    return v3((m[0] * v[0] + m[3] * v[1]) + m[6] * v[2], (m[1] * v[0] + m[4] * v[1]) + m[7] * v[2],
               (m[2] * v[0] + m[5] * v[1]) + m[8] * v[2])
 
 
 def error_matrix(rt, rc):
     """R_e = R_tᵀ R_c, nine (N,) arrays, row-major."""
-    return tuple(_f32((rt[i] * rc[j] + rt[3 + i] * rc[3 + j]) + rt[6 + i] * rc[6 + j])
+    return tuple(f32((rt[i] * rc[j] + rt[3 + i] * rc[3 + j]) + rt[6 + i] * rc[6 + j])
                  for i in range(3) for j in range(3))
 
 
 def e_apply(q0, e, v):
-    c = cross(e, v)
-    return _v(*(F32(0.5) * (q0 * v[i] + c[i]) for i in range(3)))
+    c = v_cross(e, v)
+    return v3(*(F32(0.5) * (q0 * v[i] + c[i]) for i in range(3)))
 
 
 def e_solve(q0, inv_q0, kk, e, v):
-    c = cross(e, v)
-    ev = dot(e, v) * inv_q0
-    return _v(*(kk * ((q0 * v[i] - c[i]) + e[i] * ev) for i in range(3)))
+    c = v_cross(e, v)
+    ev = v_dot(e, v) * inv_q0
+    return v3(*(kk * ((q0 * v[i] - c[i]) + e[i] * ev) for i in range(3)))
 
 
 def shaping(k: Constants32, x):
@@ -84,29 +68,29 @@ def shaping(k: Constants32, x):
     p = ax * q
     f = np.where(inside, k.r1 * x + (k.r2 * x) * ax, np.where(x < F32(0.0), -p, p))
     slope = np.where(inside, k.r1 + k.r2x2 * ax, k.gamma * q)
-    return _f32(f, "shaping"), _f32(slope, "shaping slope")
+    return f32(f, "shaping"), f32(slope, "shaping slope")
 
 
 def sig_pow(k: Constants32, d):
     p = detmath.powf_const(np.abs(d), detmath.powc_tables(k.gamma))
-    return _f32(np.where(d < F32(0.0), -p, p), "sig_pow")
+    return f32(np.where(d < F32(0.0), -p, p), "sig_pow")
 
 
 def force_terms(k: Constants32, re, w_c, w_e, wdot_t, w_ev_dot, u):
     """a = F − J ω̇_ev + u formed as −ω_c×Jω_c − J(ω_c×ω_e + R_eᵀω̇_t + ω̇_ev) + u (one J product)."""
     J = tuple(k.J)
-    gyro = cross(w_c, mat_vec(J, w_c))
-    inner = cross(w_c, w_e)
+    gyro = v_cross(w_c, mat_vec(J, w_c))
+    inner = v_cross(w_c, w_e)
     feed = mat_t_vec(re, wdot_t)
-    j_sum = mat_vec(J, _v(*((inner[i] + feed[i]) + w_ev_dot[i] for i in range(3))))
-    return _v(*((-gyro[i] - j_sum[i]) + u[i] for i in range(3)))
+    j_sum = mat_vec(J, v3(*((inner[i] + feed[i]) + w_ev_dot[i] for i in range(3))))
+    return v3(*((-gyro[i] - j_sum[i]) + u[i] for i in range(3)))
 
 
 def compensation(k: Constants32, delta, dsq):
     norm = detmath.sqrtf(dsq)
     outer = norm > k.n1
     kk = k.ua_gain / norm
-    return _v(*(np.where(outer, kk * delta[i], k.ua_inner * sig_pow(k, delta[i])) for i in range(3)))
+    return v3(*(np.where(outer, kk * delta[i], k.ua_inner * sig_pow(k, delta[i])) for i in range(3)))
 
 
 def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
@@ -118,26 +102,26 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     inv_om = m * rr
     barrier = k.lam * detmath.logf_tab(om)
     fs = [shaping(k, x1[i]) for i in range(3)]
-    g = _v(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
+    g = v3(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
     w_ev = e_solve(q0, inv_q0, kk, x1, g)
-    x2 = _v(*(w_e[i] - w_ev[i] for i in range(3)))
+    x2 = v_sub(w_e, w_ev)
     x1_dot = e_apply(q0, x1, w_e)
-    q0_dot = F32(-0.5) * dot(x1, w_e)
+    q0_dot = F32(-0.5) * v_dot(x1, w_e)
     e_dot_w = e_apply(q0_dot, x1_dot, w_ev)
-    radial = (k.nlam2 * dot(x1, x1_dot)) * inv_om
-    dg = _v(*(((k.nbeta1 - k.beta2 * fs[i][1]) + barrier) * x1_dot[i] + radial * x1[i] for i in range(3)))
-    dg = _v(*(dg[i] - e_dot_w[i] for i in range(3)))
+    radial = (k.nlam2 * v_dot(x1, x1_dot)) * inv_om
+    dg = v3(*(((k.nbeta1 - k.beta2 * fs[i][1]) + barrier) * x1_dot[i] + radial * x1[i] for i in range(3)))
+    dg = v_sub(dg, e_dot_w)
     w_ev_dot = e_solve(q0, inv_q0, kk, x1, dg)
-    u = _v(*((k.nk1 * detmath.tanhf(k.eps1 * varpi[i]) - k.k2 * detmath.tanhf(k.eps2 * x1[i]))
+    u = v3(*((k.nk1 * detmath.tanhf(k.eps1 * varpi[i]) - k.k2 * detmath.tanhf(k.eps2 * x1[i]))
              - k.k3 * detmath.tanhf(k.eps3 * x1_dot[i]) for i in range(3)))
     a = force_terms(k, re, w_c, w_e, wdot_t, w_ev_dot, u)
-    delta = _v(*(x2[i] - varpi[i] for i in range(3)))
-    dsq = dot(delta, delta)
+    delta = v_sub(x2, varpi)
+    dsq = v_dot(delta, delta)
     inv_sq = F32(1.0) / np.where(dsq <= k.delta_reg, dsq + k.delta_reg, dsq)
-    along = ((((dot(x2, a) + dot(x1, x1_dot)) + k.k5) + k.d_max * detmath.sqrtf(dot(x2, x2))) * inv_sq) + k.k4
+    along = ((((v_dot(x2, a) + v_dot(x1, x1_dot)) + k.k5) + k.d_max * detmath.sqrtf(v_dot(x2, x2))) * inv_sq) + k.k4
     j_inv_a = mat_vec(tuple(k.J_inv), a)
     ua = compensation(k, delta, dsq)
-    vdot = _v(*((j_inv_a[i] + along * delta[i]) + ua[i] for i in range(3)))
+    vdot = v3(*((j_inv_a[i] + along * delta[i]) + ua[i] for i in range(3)))
     return u, vdot, x2
 
 
@@ -158,33 +142,33 @@ def error_near_180(re, tr):
     for j in range(3):
         off = np.choose(k, tuple(re[3 * j + kk] + re[3 * kk + j] for kk in range(3))) * scale
         e.append(np.where(ek == F32(0.0), F32(0.0), np.where(k == j, ek, off)))
-    return _v(*e)
+    return v3(*e)
 
 
 def fallback(k: Constants32, e, w_e):
-    return _v(*(k.nk2 * detmath.tanhf(k.eps2 * e[i]) - k.k3 * detmath.tanhf(k.eps3 * w_e[i]) for i in range(3)))
+    return v3(*(k.nk2 * detmath.tanhf(k.eps2 * e[i]) - k.k3 * detmath.tanhf(k.eps3 * w_e[i]) for i in range(3)))
 
 
 def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
     """(u, vdot, x1, x2, status, inputs_ok) as {name}_law; inputs_ok: R_e, w_e and wdot_t finite."""
     re = error_matrix(rt, rc)
     rw = mat_t_vec(re, w_t)
-    w_e = _v(*(w_c[i] - rw[i] for i in range(3)))
+    w_e = v_sub(w_c, rw)
     inputs_ok = sum_is_finite(re + w_e + wdot_t)
     tr = (re[0] + re[4]) + re[8]
     opt = F32(1.0) + tr
     upper = opt > k.q0min_sq4
     s = detmath.sqrtf(opt)
     k_e = F32(0.5) / s
-    x1 = _v((re[7] - re[5]) * k_e, (re[2] - re[6]) * k_e, (re[3] - re[1]) * k_e)
-    nsq = dot(x1, x1)
+    x1 = v3((re[7] - re[5]) * k_e, (re[2] - re[6]) * k_e, (re[3] - re[1]) * k_e)
+    nsq = v_dot(x1, x1)
     om = np.where(upper, F32(1.0) - nsq, F32(0.0))
     regular = om > k.q0min_sq
     u_n, vdot_n, x2_n = nominal(k, varpi, re, F32(0.5) * s, k_e, x1, nsq, om, w_c, w_e, wdot_t)
     e_s = error_near_180(re, tr)
     u_s = fallback(k, e_s, w_e)
     zero = np.zeros_like(tr)
-    pick = lambda a, b: _v(*(np.where(regular, a[i], b[i]) for i in range(3)))  # noqa: E731
+    pick = lambda a, b: v3(*(np.where(regular, a[i], b[i]) for i in range(3)))  # noqa: E731
     status = np.where(regular, STATUS_OK, STATUS_SINGULAR).astype(np.uint32)
     return (pick(u_n, u_s), pick(vdot_n, (zero, zero, zero)), pick(x1, e_s),
             pick(x2_n, (zero, zero, zero)), status, inputs_ok)
@@ -195,7 +179,7 @@ def sum_is_finite(values) -> np.ndarray:
     finite and no overflow); s - s == 0 exactly when s is finite."""
     acc = values[0]
     for v in values[1:]:
-        acc = _f32(acc + v, "sum")
+        acc = f32(acc + v, "sum")
     return (acc - acc) == F32(0.0)
 
 
@@ -221,14 +205,14 @@ def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndar
         varpi = tuple(np.where(state_ok, c, zero) for c in varpi)
         new = []
         for i in range(3):
-            v = _f32(varpi[i] + k.period * vdot[i], "euler")
+            v = f32(varpi[i] + k.period * vdot[i], "euler")
             new.append(np.where(v > k.limit, k.limit, np.where(v < -k.limit, -k.limit, v)))
     new_state = np.stack(new, axis=1).astype(F32, copy=False)
     out = np.empty((state.shape[0], N_OUT), dtype=F32)
     for i in range(3):
         out[:, i], out[:, 3 + i], out[:, 6 + i], out[:, 9 + i] = u[i], x1[i], x2[i], new_state[:, i]
     out[:, 12] = status.view(F32)
-    return _f32(new_state, "state"), out
+    return f32(new_state, "state"), out
 
 
 def _records(a, n: int, what: str) -> np.ndarray:
