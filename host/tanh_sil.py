@@ -21,6 +21,7 @@ paper-000 example, with metrics against the float64 sampled run), cycle_report /
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -32,6 +33,7 @@ from codegen import golden_tanh as gt
 from codegen.tanh_emit import DEFAULT_NAME, DEFAULT_PERIOD, constants32, tanh_sources
 from codegen.tanh_params import TanhParams
 from host.errors import HostError
+from tools import atomic
 
 F32 = np.float32
 
@@ -332,6 +334,10 @@ def run_in_loop(target: str, period: float = DEFAULT_PERIOD, duration: float = 4
     if e_c.shape != e_64.shape:
         raise HostError("C and float64 runs have different lengths (internal error)")
     diff = np.abs(e_c - e_64)
+    # The yardstick for diff: the float64 run itself, started from w_c(0) rounded to float32 (what
+    # any float32 interface does to the state), moves by this much (docs/tanh-controller.md).
+    sc32 = dataclasses.replace(sc, w_c0=tuple(float(np.float32(w)) for w in sc.w_c0))
+    self_diff = np.abs(np.linalg.norm(ex.simulate_sampled(sc32, period, duration, dt)["e"], axis=1) - e_64)
     late = history["t"] >= 25.0
     metrics.update({
         "mode": f"sampled, C in the loop ({'SIL x86' if target == 'x86' else 'PIL ARM emulator'})",
@@ -341,6 +347,7 @@ def run_in_loop(target: str, period: float = DEFAULT_PERIOD, duration: float = 4
         "e_diff_max": float(diff.max()), "e_diff_after_25s": float(diff[late].max()) if late.any() else None,
         "t_e_diff_above_1e-6": float(history["t"][np.argmax(diff > 1e-6)]) if (diff > 1e-6).any() else None,
         "t_settle_float64": ex.metrics_of(ref)["t_settle"], "e_final_float64": float(e_64[-1]),
+        "e_diff_float64_self_max": float(self_diff.max()),
         "parameters": sc.params.to_mapping(),
     })
     if "cycles" in history:
@@ -349,7 +356,31 @@ def run_in_loop(target: str, period: float = DEFAULT_PERIOD, duration: float = 4
                         "cycles_max": int(cyc.max())})
     if out_dir is not None:
         ex.write_outputs(Path(out_dir), metrics, history)
+        _plot_c_vs_float64(Path(out_dir) / "fig_c_vs_float64.png", history["t"], diff, self_diff, metrics)
     return {**metrics, "metrics": metrics, "history": history, "reference": ref}
+
+
+def _plot_c_vs_float64(path: Path, t: np.ndarray, diff: np.ndarray, self_diff: np.ndarray, metrics: dict) -> None:
+    """|‖e‖_C − ‖e‖_float64| over the run, beside the float64 run's own change from a float32-rounded
+    w_c(0), on a log scale with the 1e-6 line of issue 7."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.semilogy(t, np.maximum(diff, 1e-16), label=f"C ({metrics['target']}) vs float64 sampled run")
+    ax.semilogy(t, np.maximum(self_diff, 1e-16), label="float64 run from w_c(0) rounded to float32 vs float64", alpha=0.8)
+    ax.axhline(1e-6, color="k", lw=0.8, ls="--", label="1e-6")
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("|Δ‖e‖| (-)")
+    ax.set_title(f"tanh law, sampled T = {metrics['period']} s: the C against the float64 run")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="lower left", fontsize=8)
+    fig.tight_layout()
+    with atomic.writing(path, suffix=".png") as tmp:
+        fig.savefig(tmp, format="png", dpi=110)
+    plt.close(fig)
 
 
 # ----------------------------------------------------------------------------- cycle report

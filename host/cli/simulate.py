@@ -102,7 +102,8 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     print(f"tanh law, paper-000 example, {mode}, {duration:g} s" + (f", {m['mode']}" if in_loop else ""))
     keys = [("t_settle", "s"), ("e_final", ""), ("we_final", "rad/s"), ("u_max", "N*m")]
     if in_loop:
-        keys += [("golden_mismatch_steps", ""), ("e_diff_max", ""), ("e_diff_after_25s", "")]
+        keys += [("golden_mismatch_steps", ""), ("e_diff_max", ""), ("e_diff_after_25s", ""),
+                 ("e_diff_float64_self_max", "")]
         keys += [("cycles_median", ""), ("cycles_max", "")] if in_loop == "arm" else []
     for key, unit in keys:
         print(f"  {key:21s} {m[key]!s:>22} {unit}")
