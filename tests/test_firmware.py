@@ -56,22 +56,25 @@ def test_build_links_no_libm_no_hal_and_no_newlib(net12):
             "sg_tanhf"} <= set(Image(build.elf).by_name)
 
 
-def test_forbidden_symbol_is_detected(tmp_path):
-    src = {"net.c": "float expf(float x);\n__attribute__((noinline)) float expf(float x) { return x; }\n"
-                    "void net_eval(const float *x, float *y) { y[0] = expf(x[0]); }\n",
+def _one_input_net(net_c: str) -> tuple[dict, str]:
+    """Sources of a 1-in 1-out `net_eval` with the given net.c, and the network adapter for it."""
+    src = {"net.c": net_c,
            "net.h": "#define NET_N_IN 1\n#define NET_N_OUT 1\nvoid net_eval(const float *x, float *y);\n"}
     adapter = arm.render_adapter("network", entry="net", header="net.h",
                                  n_in_macro="NET_N_IN", n_out_macro="NET_N_OUT")
+    return src, adapter
+
+
+def test_forbidden_symbol_is_detected(tmp_path):
+    src, adapter = _one_input_net("float expf(float x);\n__attribute__((noinline)) float expf(float x) { return x; }\n"
+                                  "void net_eval(const float *x, float *y) { y[0] = expf(x[0]); }\n")
     with pytest.raises(FirmwareError, match="forbidden library symbols linked: expf"):
         arm.build(src, adapter)
 
 
 def test_libm_call_does_not_link():
-    src = {"net.c": "float tanhf(float x);\n"
-                    "void net_eval(const float *x, float *y) { y[0] = tanhf(x[0]); }\n",
-           "net.h": "#define NET_N_IN 1\n#define NET_N_OUT 1\nvoid net_eval(const float *x, float *y);\n"}
-    adapter = arm.render_adapter("network", entry="net", header="net.h",
-                                 n_in_macro="NET_N_IN", n_out_macro="NET_N_OUT")
+    src, adapter = _one_input_net("float tanhf(float x);\n"
+                                  "void net_eval(const float *x, float *y) { y[0] = tanhf(x[0]); }\n")
     with pytest.raises(FirmwareError, match="undefined reference to `tanhf'"):
         arm.build(src, adapter)
     # Only a peer build (third-party C measured for comparison) may link libm and newlib.
