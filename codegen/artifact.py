@@ -22,7 +22,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from codegen.errors import CodegenError
-from tools import atomic
+from codegen import atomic
 
 FORMAT = "staregen.mlp-artifact"
 VERSION = 1

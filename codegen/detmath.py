@@ -22,6 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
+from codegen.cgen import c_float
+
 F32 = np.float32
 U32 = np.uint32
 
@@ -492,14 +494,12 @@ def powc_tables(y) -> PowC:
 def powc_c_initializer(t: PowC, indent: str = "    ") -> str:
     """The C initializer of an sg_powc_t (hex-float literals): y, p, the 32 interval rows {c_i, 1/c_i,
     c_i^y, 0} (c_i, 1/c_i those of sg_powf_tab_log) and 2^(y k), 8 per line."""
-    from codegen.emit import c_float as _c_hex  # the one float32 -> exact C literal (keeps -0, refuses NaN)
-
     def rows(a):
-        return (",\n" + indent * 2).join(", ".join(_c_hex(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
+        return (",\n" + indent * 2).join(", ".join(c_float(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
     interval_rows = (",\n" + indent * 2).join(
-        "{" + ", ".join(_c_hex(v) for v in (F32(c), F32(ic), cy, F32(0.0))) + "}"
+        "{" + ", ".join(c_float(v) for v in (F32(c), F32(ic), cy, F32(0.0))) + "}"
         for (c, ic, _log2c), cy in zip(_PT_LOG, t.cy))
-    return ("{\n" + indent + _c_hex(t.y) + ",\n" + indent + "{" + ", ".join(_c_hex(v) for v in t.p) + "},\n"
+    return ("{\n" + indent + c_float(t.y) + ",\n" + indent + "{" + ", ".join(c_float(v) for v in t.p) + "},\n"
             + indent + "{\n" + indent * 2 + interval_rows + "\n" + indent + "},\n"
             + indent + "{\n" + indent * 2 + rows(t.ek) + "\n" + indent + "}\n}")
 

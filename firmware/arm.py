@@ -21,7 +21,6 @@ from pathlib import Path
 from typing import Mapping, Sequence
 
 import jinja2
-import numpy as np
 
 from firmware import symbols
 from firmware.errors import FirmwareError
@@ -75,13 +74,14 @@ def compiler_version() -> str:
 
 
 def render_adapter(kind: str, **params) -> str:
-    """C text of firmware/adapters/<kind>.c.j2 (network: entry, header, n_in_macro, n_out_macro;
-    stateful: entry, header, state_t, input_t, output_t)."""
+    """C text of firmware/adapters/<kind>.c.j2 (records: entry, header, step, layout_checks, input_words,
+    output_words, state_words (0: stateless); sequence: the same plus init)."""
     path = ADAPTERS / f"{kind}.c.j2"
     if not path.is_file():
         known = ", ".join(sorted(p.name[:-5] for p in ADAPTERS.glob("*.c.j2")))
         raise FirmwareError(f"no harness adapter '{kind}' (known: {known})")
-    env = jinja2.Environment(undefined=jinja2.StrictUndefined, keep_trailing_newline=True)
+    env = jinja2.Environment(undefined=jinja2.StrictUndefined, keep_trailing_newline=True, trim_blocks=True,
+                             lstrip_blocks=True)
     try:
         return env.from_string(path.read_text(encoding="utf-8")).render(**params)
     except jinja2.UndefinedError as exc:
@@ -198,16 +198,6 @@ def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool
     return ArmBuild(folder, folder / "firmware.elf", folder / "firmware.map", newlib)
 
 
-def network_build(artifact, name: str = "network", opt: str = "-O2") -> ArmBuild:
-    """The generated network path of an artifact with the network adapter."""
-    from codegen.emit import network_sources
-
-    P = name.upper()
-    adapter = render_adapter("network", entry=name, header=f"{name}.h",
-                             n_in_macro=f"{P}_N_IN", n_out_macro=f"{P}_N_OUT")
-    return build(network_sources(artifact, name), adapter, opt)
-
-
 def bench_build(out_dir: Path) -> Path:
     """Assemble the micro-benchmarks (firmware/bench/*.S) into one ELF in out_dir."""
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -219,35 +209,3 @@ def bench_build(out_dir: Path) -> Path:
     if res.returncode != 0:
         raise FirmwareError(f"bench build failed: {_one_line(res.stderr)}")
     return elf
-
-
-class ArmNetwork:
-    """A network ELF run in the emulator through the harness (records = float32 rows)."""
-
-    def __init__(self, elf: str | os.PathLike):
-        from tools.m4.harness import Harness
-
-        self.harness = Harness(elf)
-        self.n_in = self.harness.in_bytes // 4
-        self.n_out = self.harness.out_bytes // 4
-
-    def eval(self, x: np.ndarray) -> np.ndarray:
-        x = np.ascontiguousarray(x)
-        if x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != self.n_in:
-            raise ValueError(f"arm eval: expected float32 of shape (N, {self.n_in}), got {x.dtype} {x.shape}")
-        out = self.harness.run(x.view(np.uint8).reshape(x.shape[0], -1))
-        return out.view(np.float32).reshape(x.shape[0], self.n_out)
-
-
-def network_arm(artifact, name: str = "network") -> ArmNetwork:
-    return ArmNetwork(network_build(artifact, name).elf)
-
-
-def eval_network_arm(artifact_or_elf, x: np.ndarray, name: str = "network") -> np.ndarray:
-    """(N, n_in) float32 -> (N, n_out) float32 through the ARM build in the emulator.
-
-    artifact_or_elf: a codegen Artifact (generated, built, cached) or the path of a built ELF.
-    """
-    if isinstance(artifact_or_elf, (str, os.PathLike)):
-        return ArmNetwork(artifact_or_elf).eval(x)
-    return network_arm(artifact_or_elf, name).eval(x)

@@ -25,7 +25,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Mapping
 
-import numpy as np
+import cffi
 
 from firmware import symbols
 from firmware.errors import FirmwareError
@@ -106,8 +106,6 @@ def compiler_version(cc: str = X86_CC) -> str:
 
 
 def build_key(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC) -> str:
-    import cffi
-
     h = hashlib.sha256()
     parts = {
         "layout": BUILD_LAYOUT, "flags": X86_FLAGS, "cc": compiler_version(cc),
@@ -163,8 +161,6 @@ def check_undefined(objects: list[Path]) -> None:
 
 
 def _build_into(folder: Path, key: str, sources: Mapping[str, str], cdef: str, harness: str, cc: str) -> None:
-    import cffi
-
     src = folder / "src"
     src.mkdir(parents=True)
     for fname, text in sources.items():
@@ -246,74 +242,3 @@ def build(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC)
             shutil.rmtree(tmp, ignore_errors=True)
     _loaded[key] = _load(folder, key)
     return _loaded[key]
-
-
-# ----------------------------------------------------------------------------- the network path
-
-NETWORK_STAGES = ("normalise", "mlp", "denormalise", "eval")
-
-
-def network_cdef(name: str) -> str:
-    """The Python-visible API: the four flight functions and a batch loop for each."""
-    lines = []
-    for stage in NETWORK_STAGES:
-        lines.append(f"void {name}_{stage}(const float *in, float *out);")
-        lines.append(f"void {name}_{stage}_batch(const float *in, float *out, size_t n);")
-    return "\n".join(lines) + "\n"
-
-
-def network_harness(name: str) -> str:
-    """Batch loops over the flight functions; the arithmetic stays in the flight object."""
-    P = name.upper()
-    dims = {"normalise": (f"{P}_N_IN", f"{P}_N_IN"), "mlp": (f"{P}_N_IN", f"{P}_N_OUT"),
-            "denormalise": (f"{P}_N_OUT", f"{P}_N_OUT"), "eval": (f"{P}_N_IN", f"{P}_N_OUT")}
-    out = [f'#include <stddef.h>\n#include "{name}.h"\n']
-    for stage, (n_in, n_out) in dims.items():
-        out.append(
-            f"static void {name}_{stage}_batch(const float *in, float *out, size_t n)\n"
-            f"{{\n    size_t r;\n    for (r = 0; r < n; ++r) {{\n"
-            f"        {name}_{stage}(in + r * {n_in}, out + r * {n_out});\n    }}\n}}\n")
-    return "\n".join(out)
-
-
-class X86Network:
-    """The generated network path on x86, called on numpy batches (rows of float32)."""
-
-    def __init__(self, build_: X86Build, name: str, n_in: int, n_out: int):
-        self.build = build_
-        self.name = name
-        self.dims = {"normalise": (n_in, n_in), "mlp": (n_in, n_out),
-                     "denormalise": (n_out, n_out), "eval": (n_in, n_out)}
-
-    def _run(self, stage: str, x: np.ndarray) -> np.ndarray:
-        n_in, n_out = self.dims[stage]
-        x = np.ascontiguousarray(x)
-        if x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != n_in:
-            raise ValueError(f"x86 {stage}: expected float32 of shape (N, {n_in}), got {x.dtype} {x.shape}")
-        y = np.empty((x.shape[0], n_out), dtype=np.float32)
-        self.build.check_fp_environment()
-        ffi = self.build.ffi
-        fn = getattr(self.build.lib, f"{self.name}_{stage}_batch")
-        fn(ffi.cast("const float *", ffi.from_buffer(x)), ffi.cast("float *", ffi.from_buffer(y)), x.shape[0])
-        return y
-
-    def normalise(self, x: np.ndarray) -> np.ndarray:
-        return self._run("normalise", x)
-
-    def mlp(self, xn: np.ndarray) -> np.ndarray:
-        return self._run("mlp", xn)
-
-    def denormalise(self, yn: np.ndarray) -> np.ndarray:
-        return self._run("denormalise", yn)
-
-    def eval(self, x: np.ndarray) -> np.ndarray:
-        return self._run("eval", x)
-
-
-def network_library(artifact, name: str = "network") -> X86Network:
-    """Generate the network C for an artifact, build it for x86 (cached) and load it."""
-    from codegen.emit import network_sources
-
-    sources = network_sources(artifact, name)
-    lib = build(sources, network_cdef(name), network_harness(name))
-    return X86Network(lib, name, artifact.n_in, artifact.n_out)

@@ -19,12 +19,20 @@ from pathlib import Path
 import numpy as np
 
 from codegen import GENERATOR_VERSION, detmath
-from codegen.emit import _environment, c_float, check_name, math_sources, write_sources
+from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 from codegen.errors import CodegenError
-from codegen.tanh_params import TanhParams, derived_constants
+from codegen.units.tanh.params import TanhParams, derived_constants
 
+TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_NAME = "tanh"
 DEFAULT_PERIOD = 0.1  # s, the paper-000 example's sampled flight version
+
+# The C structs of templates/tanh.h.j2 as numpy records (4-byte fields: no padding).
+INPUT_DTYPE = np.dtype([("R_c", "<f4", (9,)), ("w_c", "<f4", (3,)), ("R_t", "<f4", (9,)), ("w_t", "<f4", (3,)),
+                        ("wdot_t", "<f4", (3,))])
+STATE_DTYPE = np.dtype([("varpi", "<f4", (3,))])
+OUTPUT_DTYPE = np.dtype([("torque", "<f4", (3,)), ("x1", "<f4", (3,)), ("x2", "<f4", (3,)), ("varpi", "<f4", (3,)),
+                         ("status", "<u4")])
 
 
 @dataclass(frozen=True)
@@ -124,7 +132,7 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
 def tanh_sources(p: TanhParams, period: float = DEFAULT_PERIOD, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text}: `<name>.h`, `<name>.c` and the sg_math library they call."""
     check_name(name)
-    env, ctx = _environment(), template_context(p, period, name)
+    env, ctx = environment(TEMPLATES), template_context(p, period, name)
     sources = {
         f"{name}.h": env.get_template("tanh.h.j2").render(ctx),
         f"{name}.c": env.get_template("tanh.c.j2").render(ctx),

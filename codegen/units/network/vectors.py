@@ -136,3 +136,16 @@ def gate_vectors(env: Envelope, n: int, seed: int = 0) -> VectorSet:
     kind = np.repeat(np.arange(len(KINDS), dtype=np.uint8), counts)
     x = np.ascontiguousarray(np.concatenate(blocks).astype(np.float32, copy=False))
     return VectorSet(x=x, kind=kind)
+
+
+def class_vectors(env: Envelope, per_class: int, seed: int) -> dict[str, np.ndarray]:
+    """per_class rows of each gate class, float32 (per_class, n_in) each (the cycle report's classes)."""
+    share = min(SHARE_BOUND, SHARE_OUTSIDE, SHARE_SPECIAL)
+    vs = gate_vectors(env, int(np.ceil(per_class / share)) + 1, seed)
+    out = {}
+    for k, name in enumerate(KINDS):
+        rows = vs.x[vs.kind == k][:per_class]
+        if rows.shape[0] < per_class:
+            raise ValueError(f"only {rows.shape[0]} vectors of class {name}")
+        out[name] = np.ascontiguousarray(rows)
+    return out

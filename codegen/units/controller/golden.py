@@ -14,12 +14,12 @@ import math
 
 import numpy as np
 
-from codegen import controller_spec as cs
+from codegen.units.controller import spec as cs
 from codegen import detmath as dm
-from codegen import golden
+from codegen.units.network import golden
 from codegen.golden_vec3 import v_add, v_cross, v_dot, v_scale, v_sub
 from codegen.artifact import Artifact
-from codegen.controller_emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, TURN32_HI, TURN32_LO, envelope_bounds
+from codegen.units.controller.emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, TURN32_HI, TURN32_LO, envelope_bounds
 
 F32, U32, U64 = np.float32, np.uint32, np.uint64
 
@@ -243,11 +243,3 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     new["integral"], new["mode"], new["clean"] = integral, mode, count
     return out, new
 
-
-def run_sequences(a: Artifact, cfg: cs.ControllerConfig, inputs: np.ndarray) -> np.ndarray:
-    """inputs (S, T) INPUT_DTYPE: S sequences of T steps from init; outputs (S, T) OUTPUT_DTYPE."""
-    state = init(inputs.shape[0])
-    out = np.zeros(inputs.shape, dtype=OUTPUT_DTYPE)
-    for k in range(inputs.shape[1]):
-        out[:, k], state = step(a, cfg, state, np.ascontiguousarray(inputs[:, k]))
-    return out

@@ -8,14 +8,17 @@ Record layouts for the harnesses (numpy structured dtypes matching the C structs
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 
 from codegen import GENERATOR_VERSION
-from codegen import controller_spec as cs
+from codegen.units.controller import spec as cs
 from codegen.artifact import Artifact
-from codegen.emit import _environment, c_float, check_name, network_sources
+from codegen.cgen import c_float, check_name, environment
+from codegen.units.network.emit import network_sources
 
+TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_NAME = "controller"
 
 INPUT_DTYPE = np.dtype([("A_bo", "<f4", 3), ("omega_b", "<f4", 3), ("R_s", "<f4", 3), ("V_s", "<f4", 3),
@@ -84,7 +87,7 @@ def controller_sources(a: Artifact, cfg: cs.ControllerConfig, name: str = DEFAUL
     check_name(name)
     if a.sizes[0] != 12 or a.sizes[2] != 3:
         raise ValueError(f"the controller needs a 12-input, 3-output network, got {a.shape_text}")
-    env, ctx = _environment(), controller_context(a, cfg, name)
+    env, ctx = environment(TEMPLATES), controller_context(a, cfg, name)
     sources = network_sources(a, net_name(name))
     sources[f"{name}.h"] = env.get_template("controller.h.j2").render(ctx)
     sources[f"{name}.c"] = env.get_template("controller.c.j2").render(ctx)

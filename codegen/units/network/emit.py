@@ -1,4 +1,4 @@
-"""C emitter: artifact -> `<name>.h` / `<name>.c` (network path) plus the deterministic math library.
+"""Network unit emitter: artifact -> `<name>.h` / `<name>.c` (the network path) plus the deterministic math library.
 
 Generation is a pure function of the artifact, the entry name and the generator version: no
 timestamps, no paths, no dict-order dependence, so the same artifact gives byte-identical sources.
@@ -6,20 +6,13 @@ timestamps, no paths, no dict-order dependence, so the same artifact gives byte-
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
-import jinja2
-import numpy as np
-
 from codegen import GENERATOR_VERSION
-from codegen.artifact import Artifact, hex_float
-from codegen.errors import CodegenError
-from tools import atomic
+from codegen.artifact import Artifact
+from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 
 TEMPLATES = Path(__file__).with_name("templates")
-CSRC = Path(__file__).with_name("csrc")
-MATH_FILES = ("sg_math.h", "sg_math.c")
 DEFAULT_NAME = "network"
 # Neurons per MLP loop iteration. Four would save ~11 cycles (12-40-3, ideal) but the loop, with
 # tanh inlined, then outgrows the STM32F4 ART's 1 KB instruction cache: 8,410 cycles instead of
@@ -28,31 +21,6 @@ UNROLL_CHOICES = (2, 1)
 # Most weights of one neuron loaded back to back before their sum: 13 (bias + 12 inputs) keeps
 # the 12 inputs, 3 output sums and the group within the FPU registers of the Cortex-M4.
 LOAD_GROUP = 13
-
-
-def c_float(value) -> str:
-    """A float32 as a C hex-float literal that round-trips exactly, e.g. 0x1.99999ap-4f."""
-    v = np.float32(value)
-    if not np.isfinite(v):
-        raise CodegenError(f"cannot emit the non-finite constant {v} as a C literal")
-    return hex_float(float(v)) + "f"
-
-
-def check_name(name: str) -> str:
-    """Entry names become C identifiers and file names: lower-case, not the math library's prefix."""
-    if not re.fullmatch(r"[a-z][a-z0-9_]{0,30}", name) or name.startswith("sg_"):
-        raise CodegenError(
-            f"--name: {name!r} must be a lower-case C identifier (a-z, 0-9, _; at most 31 characters) "
-            "not starting with 'sg_'")
-    return name
-
-
-def _environment() -> jinja2.Environment:
-    return jinja2.Environment(
-        loader=jinja2.FileSystemLoader(str(TEMPLATES)),
-        undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
-        keep_trailing_newline=True, autoescape=False,
-    )
 
 
 def _labels(names, units, descriptions, lows=None, highs=None) -> list[dict]:
@@ -110,35 +78,16 @@ def template_context(a: Artifact, name: str) -> dict:
     }
 
 
-def math_sources() -> dict[str, str]:
-    """The deterministic math library (codegen/csrc), copied verbatim next to the network."""
-    sources = {}
-    for fname in MATH_FILES:
-        path = CSRC / fname
-        if not path.is_file():
-            raise CodegenError(f"{path}: missing (the deterministic math library sg_math is not installed)")
-        sources[fname] = path.read_text(encoding="utf-8")
-    return sources
-
-
 def network_sources(a: Artifact, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text} of the generated network path and the math library it calls."""
     check_name(name)
-    env, ctx = _environment(), template_context(a, name)
+    env, ctx = environment(TEMPLATES), template_context(a, name)
     sources = {
         f"{name}.h": env.get_template("network.h.j2").render(ctx),
         f"{name}.c": env.get_template("network.c.j2").render(ctx),
     }
     sources.update(math_sources())
     return sources
-
-
-def write_sources(sources: dict[str, str], out_dir: str | os.PathLike) -> list[Path]:
-    """Write each file atomically into out_dir (created if needed); other files there are left alone."""
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not out_dir.is_dir():
-        raise CodegenError(f"--out: {out_dir} exists and is not a directory")
-    return [atomic.write_text(out_dir / fname, text) for fname, text in sorted(sources.items())]
 
 
 def emit(a: Artifact, out_dir: str | os.PathLike, name: str = DEFAULT_NAME) -> list[Path]:

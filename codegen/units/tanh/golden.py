@@ -9,9 +9,9 @@ u_a (20), as in the C. Constants are the float32 values of codegen.tanh_emit.con
 same ones the C carries as hex floats. Every stage asserts float32 (numpy 2 promotes float32
 with a float64 scalar).
 
-Records use the C struct layouts: input (N, 27) = R_c[9], w_c[3], R_t[9], w_t[3], wdot_t[3];
-state (N, 3) = varpi; output (N, 13) = torque[3], x1[3], x2[3], varpi[3], status (uint32 bits,
-viewed as float32 in the record).
+Records are the structured dtypes of codegen.units.tanh.emit, equal to the C structs:
+INPUT_DTYPE {R_c[9], w_c[3], R_t[9], w_t[3], wdot_t[3]}, STATE_DTYPE {varpi[3]},
+OUTPUT_DTYPE {torque[3], x1[3], x2[3], varpi[3], status (uint32)}.
 """
 from __future__ import annotations
 
@@ -19,18 +19,10 @@ import numpy as np
 
 from codegen import detmath
 from codegen.golden_vec3 import f32, v3, v_cross, v_dot, v_sub
-from codegen.tanh_emit import Constants32
+from codegen.units.tanh.emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, Constants32
 
 F32 = np.float32
-N_IN = 27
-N_STATE = 3
-N_OUT = 13
 STATUS_OK, STATUS_SINGULAR, STATUS_INVALID_INPUT = 0, 1, 2
-# Input record fields: name -> column slice.
-FIELDS = {"R_c": slice(0, 9), "w_c": slice(9, 12), "R_t": slice(12, 21), "w_t": slice(21, 24),
-          "wdot_t": slice(24, 27)}
-OUT_FIELDS = {"torque": slice(0, 3), "x1": slice(3, 6), "x2": slice(6, 9), "varpi": slice(9, 12),
-              "status": slice(12, 13)}
 
 
 def mat_vec(m, v):
@@ -183,18 +175,20 @@ def sum_is_finite(values) -> np.ndarray:
     return (acc - acc) == F32(0.0)
 
 
-def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """One {name}_step on N independent (state, input) rows: (new state (N, 3), output (N, 13))."""
-    state, inputs = _records(state, N_STATE, "state"), _records(inputs, N_IN, "inputs")
+def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One {name}_step on N independent rows: (outputs OUTPUT_DTYPE (N,), new states STATE_DTYPE (N,))."""
+    if state.dtype != STATE_DTYPE or inp.dtype != INPUT_DTYPE or state.shape != inp.shape or inp.ndim != 1:
+        raise ValueError(f"golden tanh: state and input must be (N,) {STATE_DTYPE} / {INPUT_DTYPE} records, "
+                         f"got {state.dtype} {state.shape} and {inp.dtype} {inp.shape}")
     with np.errstate(all="ignore"):
-        state_ok = sum_is_finite(tuple(state[:, j] for j in range(3)))
-        col = lambda a, j: np.ascontiguousarray(a[:, j])  # noqa: E731
-        vec = lambda name: tuple(col(inputs, j) for j in range(FIELDS[name].start, FIELDS[name].stop))  # noqa: E731
-        varpi = tuple(col(state, j) for j in range(3))
+        field = lambda rec, name, j: np.ascontiguousarray(rec[name][:, j])  # noqa: E731
+        vec = lambda name: tuple(field(inp, name, j) for j in range(inp.dtype[name].shape[0]))  # noqa: E731
+        varpi = tuple(field(state, "varpi", j) for j in range(3))
+        state_ok = sum_is_finite(varpi)
         u, vdot, x1, x2, status, inputs_ok = law(k, varpi, vec("R_c"), vec("w_c"), vec("R_t"), vec("w_t"),
                                                  vec("wdot_t"))
         ok = state_ok & inputs_ok
-        zero = np.zeros(state.shape[0], dtype=F32)
+        zero = np.zeros(inp.shape[0], dtype=F32)
         result_ok = sum_is_finite(u + vdot)
         keep = ok & result_ok
         u = tuple(np.where(keep, c, zero) for c in u)
@@ -206,29 +200,11 @@ def step(k: Constants32, state: np.ndarray, inputs: np.ndarray) -> tuple[np.ndar
         new = []
         for i in range(3):
             v = f32(varpi[i] + k.period * vdot[i], "euler")
-            new.append(np.where(v > k.limit, k.limit, np.where(v < -k.limit, -k.limit, v)))
-    new_state = np.stack(new, axis=1).astype(F32, copy=False)
-    out = np.empty((state.shape[0], N_OUT), dtype=F32)
+            new.append(f32(np.where(v > k.limit, k.limit, np.where(v < -k.limit, -k.limit, v)), "state"))
+    new_state = np.zeros(inp.shape[0], dtype=STATE_DTYPE)
+    out = np.zeros(inp.shape[0], dtype=OUTPUT_DTYPE)
     for i in range(3):
-        out[:, i], out[:, 3 + i], out[:, 6 + i], out[:, 9 + i] = u[i], x1[i], x2[i], new_state[:, i]
-    out[:, 12] = status.view(F32)
-    return f32(new_state, "state"), out
-
-
-def _records(a, n: int, what: str) -> np.ndarray:
-    a = np.asarray(a)
-    if a.dtype != F32 or a.ndim != 2 or a.shape[1] != n:
-        raise ValueError(f"golden_tanh: {what} must be float32 of shape (N, {n}), got {a.dtype} {a.shape}")
-    return a
-
-
-def run_sequences(k: Constants32, inputs: np.ndarray) -> np.ndarray:
-    """S independent time series from varpi = 0: inputs (S, T, 27) -> outputs (S, T, 13)."""
-    inputs = np.asarray(inputs)
-    if inputs.dtype != F32 or inputs.ndim != 3 or inputs.shape[2] != N_IN:
-        raise ValueError(f"golden_tanh: sequences must be float32 (S, T, {N_IN}), got {inputs.dtype} {inputs.shape}")
-    state = np.zeros((inputs.shape[0], N_STATE), dtype=F32)
-    out = np.empty(inputs.shape[:2] + (N_OUT,), dtype=F32)
-    for t in range(inputs.shape[1]):
-        state, out[:, t] = step(k, state, np.ascontiguousarray(inputs[:, t]))
-    return out
+        new_state["varpi"][:, i] = new[i]
+        out["torque"][:, i], out["x1"][:, i], out["x2"][:, i], out["varpi"][:, i] = u[i], x1[i], x2[i], new[i]
+    out["status"] = status
+    return out, new_state

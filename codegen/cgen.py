@@ -1,0 +1,68 @@
+"""What every generated unit's emitter shares: exact C literals, entry names, the jinja2
+environment (a unit's own templates plus the shared ones in codegen/templates), the
+deterministic math library copied beside the unit, and atomic writing of the sources.
+
+Generation is a pure function of its inputs and the generator version: no timestamps, no paths,
+no dict-order dependence, so the same inputs give byte-identical sources.
+"""
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import jinja2
+import numpy as np
+
+from codegen import atomic
+from codegen.artifact import hex_float
+from codegen.errors import CodegenError
+
+SHARED_TEMPLATES = Path(__file__).with_name("templates")
+CSRC = Path(__file__).with_name("csrc")
+MATH_FILES = ("sg_math.h", "sg_math.c")
+
+
+def c_float(value) -> str:
+    """A float32 as a C hex-float literal that round-trips exactly, e.g. 0x1.99999ap-4f."""
+    v = np.float32(value)
+    if not np.isfinite(v):
+        raise CodegenError(f"cannot emit the non-finite constant {v} as a C literal")
+    return hex_float(float(v)) + "f"
+
+
+def check_name(name: str) -> str:
+    """Entry names become C identifiers and file names: lower-case, not the math library's prefix."""
+    if not re.fullmatch(r"[a-z][a-z0-9_]{0,30}", name) or name.startswith("sg_"):
+        raise CodegenError(
+            f"--name: {name!r} must be a lower-case C identifier (a-z, 0-9, _; at most 31 characters) "
+            "not starting with 'sg_'")
+    return name
+
+
+def environment(unit_templates: Path) -> jinja2.Environment:
+    """Templates are looked up in the unit's own folder first, then in the shared one."""
+    return jinja2.Environment(
+        loader=jinja2.FileSystemLoader([str(unit_templates), str(SHARED_TEMPLATES)]),
+        undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+        keep_trailing_newline=True, autoescape=False,
+    )
+
+
+def math_sources() -> dict[str, str]:
+    """The deterministic math library (codegen/csrc), copied verbatim next to a unit."""
+    sources = {}
+    for fname in MATH_FILES:
+        path = CSRC / fname
+        if not path.is_file():
+            raise CodegenError(f"{path}: missing (the deterministic math library sg_math is not installed)")
+        sources[fname] = path.read_text(encoding="utf-8")
+    return sources
+
+
+def write_sources(sources: dict[str, str], out_dir: str | os.PathLike) -> list[Path]:
+    """Write each file atomically into out_dir (created if needed); other files there are left alone."""
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise CodegenError(f"--out: {out_dir} exists and is not a directory")
+    return [atomic.write_text(out_dir / fname, text) for fname, text in sorted(sources.items())]
