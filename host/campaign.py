@@ -28,7 +28,7 @@ from host.errors import HostError
 from host.metrics import DEFAULT_PLAN, ImagingPlan, StaringMetrics, average_metrics, staring_metrics
 from host.simulator import History, SimConfig, environment_track, simulate_targets
 from host.targets import Target
-from tools import atomic
+from codegen import atomic
 
 
 @dataclass

@@ -17,7 +17,7 @@ from host.constants import DEG
 from host.controllers import ARTIFACT_CONTROLLERS, build_controller
 from host.simulator import History, SimConfig, simulate
 from host.targets import central_target
-from tools import atomic
+from codegen import atomic
 
 IMPULSE_START = 30.0     # s
 IMPULSE_LENGTH = 0.5     # s

@@ -20,7 +20,7 @@ import functools
 import numpy as np
 
 from codegen import artifact as art
-from codegen import controller_spec as cs
+from codegen.units.controller import spec as cs
 from host.constants import DEG, MU_EARTH, WGS84_A, WGS84_E2
 from host.controllers import ControlOutput, Measurement
 from host.pid import TABLE1_GAINS

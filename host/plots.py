@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from host.constants import DEG  # noqa: E402
-from tools import atomic  # noqa: E402
+from codegen import atomic  # noqa: E402
 
 _AXES = ("x", "y", "z")
 

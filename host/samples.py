@@ -28,7 +28,7 @@ import numpy as np
 
 from host.errors import HostError
 from host.ocp import OcpConfig, solver_for
-from tools import atomic
+from codegen import atomic
 
 # Table 2 of paper 001, in its units (°/s, °/s², °, °/s); tests check it equals codegen's copy.
 S_IN_NAMES = ("w_dx", "w_dy", "w_dz", "wdot_dx", "wdot_dy", "wdot_dz",
@@ -270,7 +270,7 @@ def open_dataset_dir(directory: Path, plan: DatasetPlan) -> None:
 
 
 def remove_stale_temporaries(directory: Path) -> None:
-    """Temporary files of writes cut short by a kill (tools.atomic names them .<name>.*.tmp)."""
+    """Temporary files of writes cut short by a kill (codegen.atomic names them .<name>.*.tmp)."""
     for path in directory.glob(".shard-*.tmp"):
         path.unlink(missing_ok=True)
 

@@ -19,7 +19,7 @@ import dask
 from host import training
 from host.distributed import dask_client, run_tasks
 from host.errors import HostError
-from tools import atomic
+from codegen import atomic
 
 FULL_ACTIVATIONS = ("tansig", "logsig", "sigmoid", "relu")
 FULL_HIDDEN = tuple(range(10, 61))

@@ -5,7 +5,7 @@ static target R_t = dcm_from_euler321(eq. 30 in degrees) (= eq. 32 to 1e-6), ω_
 disturbance d = 0.002·[sin 0.1t, cos 0.2t, sin 0.2t] N·m, parameters of section 4.2 plus
 d_max = 0.0035 N·m (not printed in the paper; the true bound of d is 0.002·√2 = 0.00283).
 
-Plant: J ω̇ = −ω × Jω + u + d, Ṙ_c = R_c[ω]×, integrated by RK4 on plain floats.
+Plant: host.rigid_body (J ω̇ = −ω × Jω + u + d, Ṙ_c = R_c[ω]×, RK4 on plain floats).
 * continuous reference (period None): the law is evaluated inside every RK4 stage and ϖ is
   integrated with the plant (a 15-state ODE);
 * sampled (period T): the law runs at t = kT on the exact state, u is held (ZOH), ϖ advances by
@@ -26,6 +26,7 @@ import numpy as np
 
 from host import rotations
 from host.errors import HostError
+from host.rigid_body import RigidBody, paper000_disturbance, rows
 from host.tanh_law import (
     LawConstants,
     Mat,
@@ -37,7 +38,7 @@ from host.tanh_law import (
     euler_update,
     evaluate_law,
 )
-from tools import atomic
+from codegen import atomic
 
 # ----------------------------------------------------------------------------- paper 000, section 4.2
 
@@ -106,49 +107,19 @@ def _mat(m) -> Mat:
 # ----------------------------------------------------------------------------- plant
 
 
-class _Plant:
-    """Rigid body J ω̇ = −ω×Jω + u + d(t), Ṙ = R[ω]× on a flat float state [R (9, rows), ω (3)]."""
-
-    def __init__(self, sc: Scenario):
-        J = np.array(sc.plant_inertia)
-        self.J = _mat(J)
-        self.J_inv = _mat(np.linalg.inv(J))
-        self.amp = sc.disturbance_amplitude
-
-    def disturbance(self, t: float) -> Vec:
-        a = self.amp
-        return (a * math.sin(0.1 * t), a * math.cos(0.2 * t), a * math.sin(0.2 * t))
-
-    def rates(self, t: float, y, u: Vec) -> list[float]:
-        """d/dt of [R rows, ω]; row i of Ṙ = R[ω]× is r_i × ω."""
-        w0, w1, w2 = y[9], y[10], y[11]
-        (a, b, c), (d, e, f), (g, h, i) = self.J
-        h0, h1, h2 = a * w0 + b * w1 + c * w2, d * w0 + e * w1 + f * w2, g * w0 + h * w1 + i * w2
-        dist = self.disturbance(t)
-        m0 = -(w1 * h2 - w2 * h1) + u[0] + dist[0]
-        m1 = -(w2 * h0 - w0 * h2) + u[1] + dist[1]
-        m2 = -(w0 * h1 - w1 * h0) + u[2] + dist[2]
-        (a, b, c), (d, e, f), (g, h, i) = self.J_inv
-        out = []
-        for k in (0, 3, 6):
-            r0, r1, r2 = y[k], y[k + 1], y[k + 2]
-            out += (r1 * w2 - r2 * w1, r2 * w0 - r0 * w2, r0 * w1 - r1 * w0)
-        out += (a * m0 + b * m1 + c * m2, d * m0 + e * m1 + f * m2, g * m0 + h * m1 + i * m2)
-        return out
+def plant(sc: Scenario) -> RigidBody:
+    """The example's rigid body (host.rigid_body) with paper 000's disturbance."""
+    return RigidBody(sc.plant_inertia, paper000_disturbance(sc.disturbance_amplitude))
 
 
-def _rows(y) -> Mat:
-    return ((y[0], y[1], y[2]), (y[3], y[4], y[5]), (y[6], y[7], y[8]))
-
-
-def _initial_state(sc: Scenario) -> list[float]:
+def initial_state(sc: Scenario) -> list[float]:
     return [x for row in sc.R_c0 for x in row] + list(sc.w_c0)
 
 
 # ----------------------------------------------------------------------------- history
 
 
-class _History:
+class History:
     """Preallocated arrays, one row per recorded instant."""
 
     def __init__(self, n: int):
@@ -184,16 +155,16 @@ class _History:
 def simulate_continuous(sc: Scenario, duration: float, dt: float) -> dict[str, np.ndarray]:
     """RK4 on [R_c, ω_c, ϖ] with the law evaluated in every stage (the continuous-time reference)."""
     c = compile_constants(sc.params)
-    plant = _Plant(sc)
-    n = _step_count(duration, dt)
+    body = plant(sc)
+    n = step_count(duration, dt)
     h = duration / n
-    hist = _History(n + 1)
-    y = _initial_state(sc) + [0.0, 0.0, 0.0]
+    hist = History(n + 1)
+    y = initial_state(sc) + [0.0, 0.0, 0.0]
 
     def f(t, y):
         varpi = (y[12], y[13], y[14])
-        out = evaluate_law(c, varpi, _rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
-        return out, plant.rates(t, y, out.torque) + list(out.varpi_dot)
+        out = evaluate_law(c, varpi, rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
+        return out, body.rates(t, y, out.torque) + list(out.varpi_dot)
 
     for k in range(n):
         t = k * h
@@ -205,7 +176,7 @@ def simulate_continuous(sc: Scenario, duration: float, dt: float) -> dict[str, n
         y = [a + h / 6.0 * (b + 2.0 * (p + q) + r) for a, b, p, q, r in zip(y, k1, k2, k3, k4)]
     out, _ = f(n * h, y)
     hist.add(n * h, out, (y[12], y[13], y[14]))
-    return {**hist.as_dict(), "R_c_final": np.array(_rows(y))}
+    return {**hist.as_dict(), "R_c_final": np.array(rows(y))}
 
 
 def simulate_sampled(sc: Scenario, period: float, duration: float, dt: float) -> dict[str, np.ndarray]:
@@ -215,41 +186,33 @@ def simulate_sampled(sc: Scenario, period: float, duration: float, dt: float) ->
     The run covers a whole number of control periods (duration rounded up).
     """
     c = compile_constants(sc.params)
-    plant = _Plant(sc)
-    n_ctrl = _step_count(duration, period)
-    n_sub = _step_count(period, dt)
+    body = plant(sc)
+    n_ctrl = step_count(duration, period)
+    n_sub = step_count(period, dt)
     h = period / n_sub
-    hist = _History(n_ctrl * n_sub + 1)
-    y = _initial_state(sc)
+    hist = History(n_ctrl * n_sub + 1)
+    y = initial_state(sc)
     varpi = (0.0, 0.0, 0.0)
     out = None
     for k in range(n_ctrl):
         t0 = k * period
-        out = evaluate_law(c, varpi, _rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
+        out = evaluate_law(c, varpi, rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
         for j in range(n_sub):
             t = t0 + j * h
             if j:
-                hist.add(t, out, varpi, *_true_errors(c, sc, y))
+                hist.add(t, out, varpi, *true_errors(c, sc, y))
             else:
                 hist.add(t, out, varpi)
-            y = _rk4_plant(plant, t, y, h, out.torque)
+            y = body.rk4_step(t, y, h, out.torque)
         varpi = euler_update(varpi, out.varpi_dot, period, sc.params.varpi_limit)
-    final = evaluate_law(c, varpi, _rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
+    final = evaluate_law(c, varpi, rows(y), (y[9], y[10], y[11]), sc.R_t, sc.w_t, sc.wdot_t)
     hist.add(n_ctrl * period, final, varpi)
-    return {**hist.as_dict(), "R_c_final": np.array(_rows(y))}
+    return {**hist.as_dict(), "R_c_final": np.array(rows(y))}
 
 
-def _rk4_plant(plant: _Plant, t: float, y, h: float, u: Vec) -> list[float]:
-    k1 = plant.rates(t, y, u)
-    k2 = plant.rates(t + 0.5 * h, [a + 0.5 * h * b for a, b in zip(y, k1)], u)
-    k3 = plant.rates(t + 0.5 * h, [a + 0.5 * h * b for a, b in zip(y, k2)], u)
-    k4 = plant.rates(t + h, [a + h * b for a, b in zip(y, k3)], u)
-    return [a + h / 6.0 * (b + 2.0 * (p + q) + r) for a, b, p, q, r in zip(y, k1, k2, k3, k4)]
-
-
-def _true_errors(c: LawConstants, sc: Scenario, y) -> tuple[Vec, Vec]:
+def true_errors(c: LawConstants, sc: Scenario, y) -> tuple[Vec, Vec]:
     """e and ω_e of the plant state between control instants (ω_t = 0 here, but keep the form)."""
-    R_e = error_matrix(sc.R_t, _rows(y))
+    R_e = error_matrix(sc.R_t, rows(y))
     _, e, _ = attitude_error(R_e, c.params.q0_min)
     w_t = sc.w_t
     w_e = tuple(y[9 + i] - (R_e[0][i] * w_t[0] + R_e[1][i] * w_t[1] + R_e[2][i] * w_t[2])
@@ -257,7 +220,7 @@ def _true_errors(c: LawConstants, sc: Scenario, y) -> tuple[Vec, Vec]:
     return e, w_e
 
 
-def _step_count(span: float, step: float) -> int:
+def step_count(span: float, step: float) -> int:
     """Number of equal steps of at most `step` covering `span` (tolerant to float noise)."""
     if not (step > 0 and math.isfinite(step)):
         raise HostError(f"step must be a positive number of seconds, got {step!r}")

@@ -23,7 +23,7 @@ import math
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from codegen.tanh_params import (  # noqa: F401 (TanhParamsError, load_params, params_from_mapping: re-exported)
+from codegen.units.tanh.params import (  # noqa: F401 (TanhParamsError, load_params, params_from_mapping: re-exported)
     TanhParams,
     TanhParamsError,
     derived_constants,
@@ -44,7 +44,7 @@ ZERO3: Vec = (0.0, 0.0, 0.0)
 # ----------------------------------------------------------------------------- parameters
 
 # The parameter file schema and its one validator (TanhParams, load_params, params_from_mapping;
-# errors are codegen.tanh_params.TanhParamsError) live in codegen.tanh_params: the C generator
+# errors are codegen.units.tanh.params.TanhParamsError) live in codegen.units.tanh.params: the C generator
 # reads them and codegen must not import host. Imported above and re-exported.
 
 
@@ -66,7 +66,7 @@ class LawConstants:
 
 
 def compile_constants(params: TanhParams) -> LawConstants:
-    """The derived constants of codegen.tanh_params.derived_constants (the C generator rounds the
+    """The derived constants of codegen.units.tanh.params.derived_constants (the C generator rounds the
     same float64 values to float32), as float tuples."""
     d = derived_constants(params)
     return LawConstants(

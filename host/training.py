@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import artifact as art
-from codegen import reference
+from codegen.units.network import reference
 from host.baselines import LinearLS, SaturatedLinear
 from host.errors import HostError
 

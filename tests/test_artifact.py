@@ -9,7 +9,7 @@ import torch
 
 import host.cli as cli
 from codegen import artifact as art
-from codegen import golden
+from codegen.units.network import golden
 
 CODEGEN_COMMANDS = ["host.cli.artifact", "host.cli.codegen", "host.cli.c_eval", "host.cli.verify"]
 

@@ -4,7 +4,7 @@ import stat
 
 import pytest
 
-from tools import atomic
+from codegen import atomic
 
 
 def test_write_replaces_whole_file_with_ordinary_permissions(tmp_path):

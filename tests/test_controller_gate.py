@@ -5,9 +5,9 @@ import subprocess
 import numpy as np
 import pytest
 
-from codegen import controller_spec as cs
-from codegen import golden_controller as gc
-from codegen.controller_emit import INPUT_DTYPE, controller_sources, to_bam
+from codegen.units.controller import spec as cs
+from codegen.units.controller import golden as gc
+from codegen.units.controller.emit import INPUT_DTYPE, controller_sources, to_bam
 from firmware import arm
 from firmware.x86_controller import X86Controller
 from host import controller_gate as gate
@@ -209,7 +209,7 @@ def test_golden_model_uses_no_numpy_math_and_no_reordering_sums():
 
 
 def test_cffi_structs_match_the_record_layouts(artifact, cfg):
-    from codegen.controller_emit import OUTPUT_DTYPE, STATE_DTYPE
+    from codegen.units.controller.emit import OUTPUT_DTYPE, STATE_DTYPE
 
     c = X86Controller(artifact, cfg)
     assert c.ffi.sizeof("controller_input_t") == INPUT_DTYPE.itemsize == 64

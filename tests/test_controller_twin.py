@@ -4,8 +4,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from codegen import controller_spec as cs
-from codegen import golden_controller as gc
+from codegen.units.controller import spec as cs
+from codegen.units.controller import golden as gc
 from host import controller_gate as gate
 from host.constants import DEG
 from host.controllers import ControlOutput, Measurement, build_controller

@@ -10,7 +10,7 @@ import pytest
 import host.cli as cli
 from codegen import GENERATOR_VERSION
 from codegen import artifact as art
-from codegen import emit
+from codegen.units.network import emit
 from codegen.errors import CodegenError
 from firmware import flags, x86
 

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from codegen import artifact as art
-from codegen import bitcompare, golden, vectors
+from codegen import bitcompare
+from codegen.units.network import golden, vectors
 from firmware import arm
 from firmware.errors import FirmwareError
 from host.cli import main

@@ -11,8 +11,9 @@ import pytest
 
 import host.cli as cli
 from codegen import artifact as art
-from codegen import reference
-from codegen import bitcompare, golden, vectors
+from codegen.units.network import reference
+from codegen import bitcompare
+from codegen.units.network import golden, vectors
 from firmware import x86
 from firmware.errors import FirmwareError
 from host.cli import c_eval

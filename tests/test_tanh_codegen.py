@@ -13,9 +13,10 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import host.cli as cli
-from codegen import bitcompare, golden_vec3, tanh_emit
-from codegen import golden_tanh as gt
-from codegen.tanh_params import TanhParamsError, load_params
+from codegen import bitcompare, golden_vec3
+from codegen.units.tanh import emit as tanh_emit
+from codegen.units.tanh import golden as gt
+from codegen.units.tanh.params import TanhParamsError, load_params
 from host import tanh_example as ex
 from host import tanh_gate, tanh_law
 from host.tanh_sil import ArmTanh, X86Tanh
@@ -252,7 +253,7 @@ def test_params_error_class_is_a_codegen_error():
 def test_n1_dsq_threshold_matches_the_sqrt_branch(n1):
     """The generated N1_DSQ: sqrtf(d) > n1 <=> d > N1_DSQ for every float32 d (checked at the
     threshold's neighbours and on random bit patterns), so u_a's branch needs no VSQRT inside n1."""
-    from codegen.tanh_emit import sqrt_gt_threshold
+    from codegen.units.tanh.emit import sqrt_gt_threshold
     n = np.float32(n1)
     t = sqrt_gt_threshold(n)
     assert np.sqrt(t) <= n

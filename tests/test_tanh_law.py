@@ -13,6 +13,7 @@ from scipy.integrate import solve_ivp
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
 
+from host import rigid_body
 from host import rotations as rot
 from host import tanh_example as ex
 from host import tanh_law as tl
@@ -195,13 +196,13 @@ def test_controller_class_mirrors_sampled_simulation():
     sc = ex.paper_scenario()
     hist = ex.simulate_sampled(sc, 0.1, 1.0, 0.1)  # one plant RK4 step per control period
     ctrl = tl.TanhController(PARAMS, period=0.1)
-    plant = ex._Plant(sc)
-    y = ex._initial_state(sc)
+    body = ex.plant(sc)
+    y = ex.initial_state(sc)
     for k in range(10):
         assert ctrl.varpi == tuple(hist["varpi"][k])
-        out = ctrl.step(np.array(ex._rows(y)), np.array(y[9:12]), np.array(sc.R_t))
+        out = ctrl.step(np.array(rigid_body.rows(y)), np.array(y[9:12]), np.array(sc.R_t))
         assert out.torque == tuple(hist["u"][k])
-        y = ex._rk4_plant(plant, 0.1 * k, y, 0.1, out.torque)
+        y = body.rk4_step(0.1 * k, y, 0.1, out.torque)
 
 
 # ----------------------------------------------------------------------------- 180° and bad input

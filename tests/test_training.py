@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from codegen import artifact as art
-from codegen import reference
-from codegen import golden
+from codegen.units.network import reference
+from codegen.units.network import golden
 from host import sweep, training
 from host.baselines import LinearLS, SaturatedLinear, pd_ff_features
 from host.cli import main as cli_main

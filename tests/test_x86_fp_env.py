@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from codegen import artifact as art
-from codegen import golden
-from codegen.controller_emit import INPUT_DTYPE, STATE_DTYPE
+from codegen.units.network import golden
+from codegen.units.controller.emit import INPUT_DTYPE, STATE_DTYPE
 from firmware import x86
 from firmware.errors import FirmwareError
 from firmware.x86_controller import X86Controller

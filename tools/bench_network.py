@@ -1,14 +1,14 @@
 """Side-by-side benchmark of the network path on the Cortex-M4 cycle model (issue 4; not a test).
 
 The same 12-40-3 network (an artifact file, e.g. a trained one, or a seeded random one) as
-  * our generated C (codegen.emit) at -O2 (the flight level), -Os and -O0 (firmware.flags.with_opt),
+  * our generated C (codegen.units.network.emit) at -O2 (the flight level), -Os and -O0 (firmware.flags.with_opt),
   * emlearn's C (pip package `emlearn`, optional extra `bench`: its "loadable" MLP, eml_net.h,
     tanhf from newlib's libm), built by firmware/arm.py with peer=True: the same flags minus
     -Werror (its headers are not -Wextra -pedantic clean), libm and newlib-nano linked,
 each run over the input classes of `staregen cycles` (inside the envelope, edges, outside,
 special values) under the cycle model in the three memory modes, plus the paper's 3.1 ms.
 
-emlearn's C has no mapminmax: it gets the normalised inputs (codegen.golden.normalise, float32,
+emlearn's C has no mapminmax: it gets the normalised inputs (codegen.units.network.golden.normalise, float32,
 the same xn our MLP sees) and its normalised outputs are mapped back on the host in float64, so
 its cycles are those of the MLP alone and its error that of its MLP and libm tanhf.
 

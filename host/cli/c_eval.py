@@ -13,9 +13,9 @@ from typing import Callable
 import numpy as np
 
 from codegen import artifact as art
-from codegen import golden
+from codegen.units.network import golden
 from host.errors import HostError
-from tools import atomic
+from codegen import atomic
 
 Evaluate = Callable[[np.ndarray], np.ndarray]
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 
 from codegen import artifact as art
-from codegen import emit
+from codegen.units.network import emit
 
 
 def register(subparsers) -> None:

@@ -17,7 +17,7 @@ import argparse
 import numpy as np
 
 from host.errors import HostError
-from tools import atomic
+from codegen import atomic
 from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES, profile_entry
 from tools.m4.profile import MODES
 
@@ -48,8 +48,8 @@ def register(subparsers) -> None:
 
 
 def class_vectors(envelope, per_class: int, seed: int) -> dict[str, np.ndarray]:
-    """per_class rows of each gate class (codegen.vectors), as float32 (N, n_in)."""
-    from codegen import vectors
+    """per_class rows of each gate class (codegen.units.network.vectors), as float32 (N, n_in)."""
+    from codegen.units.network import vectors
 
     share = min(vectors.SHARE_BOUND, vectors.SHARE_OUTSIDE, vectors.SHARE_SPECIAL)
     vs = vectors.gate_vectors(envelope, int(np.ceil(per_class / share)) + 1, seed)
@@ -170,7 +170,7 @@ def publish(args: argparse.Namespace, entry_name: str, entry: dict, lines: list[
 
 def run_tanh(args: argparse.Namespace, modes) -> int:
     """tanh_step of paper 000's saturation law (host/tanh_sil.py builds, classes, report)."""
-    from codegen.tanh_params import load_params
+    from codegen.units.tanh.params import load_params
     from host import tanh_sil
 
     if not args.params:

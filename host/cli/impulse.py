@@ -13,7 +13,7 @@ from host.cli.args import parse_int, parse_number
 from host.cli.simulate import check_output_folder, controller_options
 from host.controllers import CONTROLLERS
 from host.errors import HostError
-from tools import atomic
+from codegen import atomic
 
 
 def register(subparsers) -> None:

@@ -24,7 +24,7 @@ from host.metrics import DEFAULT_PLAN
 from host.orbit import TABLE5_ELEMENTS, TABLE5_EPOCH_UTC
 from host.simulator import SimConfig, environment_track
 from host.targets import central_target
-from tools import atomic
+from codegen import atomic
 
 PRESET_DURATION_S = 100.0
 PRESET_SEED = 0
@@ -103,7 +103,7 @@ def stage_train(ctx: PipelineContext) -> None:
 
 def stage_codegen(ctx: PipelineContext) -> None:
     """Flight C of the network path into <out>/c (network.h/.c, sg_math.h/.c)."""
-    from codegen import emit
+    from codegen.units.network import emit
 
     files = emit.emit(ctx.artifact, ctx.out / "c", name="network")
     ctx.results["codegen"] = {"folder": "c", "files": sorted(Path(f).name for f in files)}

@@ -16,7 +16,7 @@ from host.errors import HostError
 from host.metrics import ImagingPlan
 from host.simulator import SimConfig
 from host.targets import parse_target
-from tools import atomic
+from codegen import atomic
 
 DEFAULT_DURATION_S = 100.0
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 import argparse
 import math
 
-from codegen import tanh_emit
-from codegen.tanh_params import load_params
+from codegen.units.tanh import emit as tanh_emit
+from codegen.units.tanh.params import load_params
 from host.errors import HostError
 
 DEFAULT_VECTORS = 100_000

@@ -13,8 +13,9 @@ import time
 import numpy as np
 
 from codegen import artifact as art
-from codegen import reference
-from codegen import bitcompare, golden, vectors
+from codegen.units.network import reference
+from codegen import bitcompare
+from codegen.units.network import golden, vectors
 from host.cli.c_eval import EVALUATORS, evaluator
 from host.errors import HostError
 

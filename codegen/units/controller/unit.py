@@ -63,8 +63,8 @@ class ControllerUnit(Unit):
 
     def describe_outputs(self, out: np.ndarray) -> str:
         pid = (out["status"] & cs.STATUS_PID) != 0
-        switches = int(np.sum(np.diff(pid, axis=-1))) if out.ndim == 2 else 0
-        return f"PID on {100.0 * np.mean(pid):.0f} % of steps, {switches} mode switches"
+        text = f"PID on {100.0 * np.mean(pid):.0f} % of steps"
+        return text + (f", {int(np.sum(np.diff(pid, axis=-1)))} mode switches" if out.ndim == 2 else "")
 
     def extra_cycle_facts(self, functions: dict, by_class: dict) -> dict:
         """The network call inside the step, and the step without it (NN path, ideal max)."""

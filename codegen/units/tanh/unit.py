@@ -44,12 +44,12 @@ class TanhUnit(Unit):
     def gate_sequences(self, n_seq: int, steps: int, seed: int) -> np.ndarray:
         if self.scenario is None:
             return vectors.open_sequences(self.constants, n_seq, steps, seed)
-        return self.scenario.sequences(self.golden, n_seq, steps, seed, self.period)
+        return self.scenario.sequences(self, n_seq, steps, seed)
 
     def cycle_classes(self, per_class: int, seed: int) -> dict[str, Batch]:
         classes = vectors.gate_classes(self.constants, per_class * len(vectors.CLASSES), seed)
         if self.scenario is not None:
-            classes.update(self.scenario.cycle_classes(self.golden, self.period))
+            classes.update(self.scenario.cycle_classes(self))
         return classes
 
     def describe_outputs(self, out: np.ndarray) -> str:

@@ -11,7 +11,7 @@ without one, `open_sequences` strings gate rows together (the state still carrie
 """
 from __future__ import annotations
 
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -138,10 +138,10 @@ def gate_classes(k: Constants32, n: int, seed: int = 0) -> dict[str, Batch]:
 class ClosedLoop(Protocol):
     """Host-side source of closed-loop inputs: the golden step flying a plant."""
 
-    def sequences(self, step: Callable, n_seq: int, steps: int, seed: int, period: float) -> np.ndarray:
-        """(n_seq, steps) INPUT_DTYPE records recorded while `step(state, inp) -> (out, state)` flies."""
+    def sequences(self, unit, n_seq: int, steps: int, seed: int) -> np.ndarray:
+        """(n_seq, steps) INPUT_DTYPE records recorded while the unit's golden step flies a plant."""
 
-    def cycle_classes(self, step: Callable, period: float) -> dict[str, Batch]:
+    def cycle_classes(self, unit) -> dict[str, Batch]:
         """Extra cycle-report classes (e.g. the records of the paper-000 example run)."""
 
 
