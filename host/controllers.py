@@ -50,9 +50,9 @@ class Controller(Protocol):
 CONTROLLERS = {
     "pid": "host.pid:make_pid_controller",
     "nn": "host.nn_controller:make_nn_controller",
-    "nn-c": "host.sil:make_sil_controller",
-    "pid-c": "host.sil:make_sil_pid_controller",
-    "nn-arm": "host.sil:make_pil_controller",
+    "nn-c": "host.generated_controller:make_sil_controller",
+    "pid-c": "host.generated_controller:make_sil_pid_controller",
+    "nn-arm": "host.generated_controller:make_pil_controller",
 }
 # Controllers built from a model artifact accept `artifact=` (a file path, None = the stand-in).
 ARTIFACT_CONTROLLERS = ("nn", "nn-c", "pid-c", "nn-arm")

@@ -6,8 +6,12 @@ import pytest
 
 from codegen.units.controller import spec as cs
 from codegen.units.controller import golden as gc
-from host import controller_gate as gate
+from codegen.units.controller.vectors import Geometry
 from host.constants import DEG
+from host.frames import L_oi
+from host.guidance import desired_state
+from host.rotations import dcm_from_euler312, euler312_from_dcm
+from host.scenarios import StaringScenario
 from host.controllers import ControlOutput, Measurement, build_controller
 from host.nn_controller import ModeLogic, NnController, TrackingPid, flight_config, load_artifact, network64
 from host.preprocess import preprocess
@@ -25,12 +29,8 @@ def artifact():
 def measurement(k: int = 300, dA=(0.0, 0.0, 0.0), dw=(0.0, 0.0, 0.0)) -> Measurement:
     """Sensors on the central-target pass at sample k (0.02 s steps) with errors in S_d (rad, rad/s)."""
     env = environment_track(1001, 0.02)
-    g = gate.Geometry(env.jd_days[k:k + 1], env.sec_of_day[k:k + 1], env.R[k:k + 1], env.V[k:k + 1],
-                      np.array([TG.lon]), np.array([TG.lat]))
-    from host.frames import L_oi
-    from host.guidance import desired_state
-    from host.rotations import dcm_from_euler312, euler312_from_dcm
-
+    g = Geometry(env.jd_days[k:k + 1], env.sec_of_day[k:k + 1], env.R[k:k + 1], env.V[k:k + 1],
+                 np.array([TG.lon]), np.array([TG.lat]))
     d = desired_state(g.jd, g.sec, g.R, g.V, g.lon, g.lat)
     L_bo = dcm_from_euler312(np.array([dA])) @ d.L_di @ np.swapaxes(L_oi(g.R, g.V), -1, -2)
     return Measurement(t=k * 0.02, jd_days=int(g.jd[0]), sec_of_day=float(g.sec[0]),
@@ -111,9 +111,10 @@ def test_golden_float32_follows_the_float64_twin(artifact):
     cfg = flight_config()
     rng = np.random.default_rng(3)
     n = 300
-    geo = gate.random_geometry(rng, n)
+    scenario = StaringScenario()
+    geo = scenario.geometry(rng, n)
     A, w = rng.uniform(-0.018, 0.018, (n, 3)) * DEG, rng.uniform(-0.0035, 0.0035, (n, 3)) * DEG
-    inp = gate.make_inputs(geo, A, w)
+    inp = scenario.inputs(geo, A, w)
     out, _ = gc.step(artifact, cfg, gc.init(n), inp)
     twin = NnController(artifact, cfg)
     worst_A = worst_M = 0.0

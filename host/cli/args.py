@@ -6,13 +6,15 @@ import math
 from host.errors import HostError
 
 
-def parse_int(text: str, what: str, minimum: int = 0) -> int:
+def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None) -> int:
     try:
         value = int(text)
     except (TypeError, ValueError):
         raise HostError(f"{what} must be an integer, got {text!r}") from None
     if value < minimum:
         raise HostError(f"{what} must be at least {minimum}, got {value}")
+    if maximum is not None and value > maximum:
+        raise HostError(f"{what} must be at most {maximum}, got {value}")
     return value
 
 

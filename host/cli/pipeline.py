@@ -25,6 +25,13 @@ from host.orbit import TABLE5_ELEMENTS, TABLE5_EPOCH_UTC
 from host.simulator import SimConfig, environment_track
 from host.targets import central_target
 from codegen import atomic
+from codegen.cgen import write_sources
+from codegen.units.network.unit import NetworkUnit
+from host.cli.simulate import check_output_folder
+from host.cli.verify import TARGETS
+from tools.gate import run_gate
+from tools.m4.profile import MODES
+from tools.report import cycle_report, cycle_text
 
 PRESET_DURATION_S = 100.0
 PRESET_SEED = 0
@@ -35,6 +42,7 @@ class PipelineContext:
     out: Path                                     # the temporary folder being built
     results: dict = field(default_factory=dict)   # stage name -> summary (goes into report.json)
     artifact: object = None                       # the network artifact (codegen.artifact.Artifact)
+    unit: object = None                           # the network unit generated from it
     report: list[str] = field(default_factory=list)
 
 
@@ -103,22 +111,18 @@ def stage_train(ctx: PipelineContext) -> None:
 
 def stage_codegen(ctx: PipelineContext) -> None:
     """Flight C of the network path into <out>/c (network.h/.c, sg_math.h/.c)."""
-    from codegen.units.network import emit
-
-    files = emit.emit(ctx.artifact, ctx.out / "c", name="network")
+    ctx.unit = NetworkUnit(ctx.artifact)
+    files = write_sources(ctx.unit.sources(), ctx.out / "c")
     ctx.results["codegen"] = {"folder": "c", "files": sorted(Path(f).name for f in files)}
     ctx.report.append("codegen: " + ", ".join(sorted(Path(f).name for f in files)) + " in c/")
 
 
 def stage_gate(ctx: PipelineContext) -> None:
     """golden == x86 C == ARM C, bit for bit, on the gate's vector set (SPEC section 6)."""
-    from host.cli.verify import gate_targets, run_gate
-
-    t0 = time.perf_counter()
-    ok = run_gate(ctx.artifact, GATE_VECTORS, GATE_SEED, gate_targets("all"))
-    ctx.results["gate"] = {"vectors": GATE_VECTORS, "targets": ["golden", *gate_targets("all")], "pass": ok,
-                           "time_s": round(time.perf_counter() - t0, 2)}
-    if not ok:
+    result = run_gate(ctx.unit, GATE_VECTORS, 0, 0, GATE_SEED, TARGETS)
+    ctx.results["gate"] = {"vectors": GATE_VECTORS, "targets": ["golden", *TARGETS], "pass": result.ok,
+                           "time_s": result.seconds["total"]}
+    if not result.ok:
         raise HostError("bit-exact gate failed: golden, x86 and ARM outputs differ (see above)")
     ctx.report.append(f"gate: golden == x86 == ARM on {GATE_VECTORS} vectors "
                       f"({ctx.results['gate']['time_s']} s)")
@@ -126,10 +130,8 @@ def stage_gate(ctx: PipelineContext) -> None:
 
 def stage_cycles(ctx: PipelineContext) -> None:
     """Cortex-M4 cycles, flash, RAM and stack of the network path (cycle model, all modes)."""
-    from host.cli.cycles import MODES, network_report, text_report
-
-    entry, facts = network_report(ctx.artifact, "network", MODES, CYCLES_PER_CLASS, GATE_SEED)
-    lines = text_report("network", entry, facts, MODES)
+    entry = cycle_report(ctx.unit, MODES, CYCLES_PER_CLASS, GATE_SEED)
+    lines = cycle_text(entry)
     atomic.write_json(ctx.out / "cycles.json", {"entries": {"network": entry}})
     atomic.write_text(ctx.out / "cycles.md", "# Cycle report (pipeline)\n\n" + "\n".join(lines) + "\n")
     worst = {m: entry["cycles"][m]["max"] for m in MODES}
@@ -157,8 +159,6 @@ def register(subparsers) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from host.cli.simulate import check_output_folder
-
     out = Path(args.out)
     check_output_folder(out, marker="report.json")
     start = time.perf_counter()

@@ -9,9 +9,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from codegen import artifact as art
+from host import tanh_example, tanh_in_loop
 from host.cli.args import parse_int, parse_number
 from host.campaign import format_table, run_campaign, validate_campaign, write_campaign
-from host.controllers import CONTROLLERS
+from host.controllers import ARTIFACT_CONTROLLERS, CONTROLLERS
 from host.errors import HostError
 from host.metrics import ImagingPlan
 from host.simulator import SimConfig
@@ -76,8 +78,6 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     """The paper-000 example (section 4.2) flown by the tanh saturation law; metrics.json + Figs. 5-8.
     tanh: the float64 law (continuous without --period); tanh-c / tanh-arm: the generated C in the
     loop (SIL / PIL, --period default 0.1 s) compared with the float64 sampled run."""
-    from host import tanh_example  # the staring scenario does not need it
-
     duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else "40",
                             "--duration", positive=True)
     in_loop = {"tanh-c": "x86", "tanh-arm": "arm"}.get(args.controller)
@@ -90,9 +90,7 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     try:
         with atomic.directory(out) as tmp:
             if in_loop:
-                from host import tanh_sil
-
-                result = tanh_sil.run_in_loop(in_loop, period, duration, dt, out_dir=tmp)
+                result = tanh_in_loop.run_in_loop(in_loop, period, duration, dt, out_dir=tmp)
             else:
                 result = tanh_example.run(period, duration, dt, out_dir=tmp)
     except OSError as exc:
@@ -113,15 +111,11 @@ def run_tanh_example(args: argparse.Namespace) -> int:
 
 def controller_options(args) -> dict:
     """Factory options: the artifact of a network controller (checked here: a clear user error)."""
-    from host.controllers import ARTIFACT_CONTROLLERS
-
     if args.controller not in ARTIFACT_CONTROLLERS:
         if args.artifact is not None:
             raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")
         return {}
     if args.artifact is not None:
-        from codegen import artifact as art
-
         art.load(args.artifact)   # a missing or invalid file is reported before anything runs
     return {"artifact": args.artifact}
 

@@ -9,7 +9,9 @@ import pytest
 
 from codegen import artifact as art
 from codegen import bitcompare
+from codegen.unit import Batch
 from codegen.units.network import golden, vectors
+from codegen.units.network.unit import NetworkUnit
 from firmware import arm
 from firmware.errors import FirmwareError
 from host.cli import main
@@ -17,6 +19,7 @@ from tools.errors import ToolError
 from tools.m4.elf import Image
 from tools.m4.harness import Harness
 from tools.m4.machine import SCB_CPACR, Machine
+from tools.runners import arm_build, runner
 from unicorn import arm_const as R
 
 
@@ -28,14 +31,18 @@ def net12():
     return art.random_artifact((12, 40, 3), seed=1)
 
 
-def _three_way(a, n, seed):
-    from firmware import x86
+def evaluate(unit, target, x):
+    rec = np.zeros(x.shape[0], dtype=unit.input_dtype)
+    rec["x"] = x
+    return np.ascontiguousarray(runner(unit, target).records(Batch(None, rec))[0]["y"])
 
+
+def _three_way(a, n, seed):
+    unit = NetworkUnit(a)
     vs = vectors.gate_vectors(a.envelope, n, seed)
     y_gold = golden.network_eval(a, vs.x)
-    y_x86 = x86.network_library(a).eval(vs.x)
-    y_arm = arm.network_arm(a).eval(vs.x)
-    return bitcompare.compare(y_gold, y_x86), bitcompare.compare(y_gold, y_arm)
+    return (bitcompare.compare(y_gold, evaluate(unit, "x86", vs.x)),
+            bitcompare.compare(y_gold, evaluate(unit, "arm", vs.x)))
 
 
 def test_three_way_gate_1e5_vectors(net12):
@@ -49,7 +56,7 @@ def test_three_way_gate_second_shape():
 
 
 def test_build_links_no_libm_no_hal_and_no_newlib(net12):
-    build = arm.network_build(net12)
+    build = arm_build(NetworkUnit(net12))
     arm.check_symbols(build.elf)
     assert not build.newlib
     assert "libm.a" not in build.map.read_text()
@@ -61,8 +68,8 @@ def _one_input_net(net_c: str) -> tuple[dict, str]:
     """Sources of a 1-in 1-out `net_eval` with the given net.c, and the network adapter for it."""
     src = {"net.c": net_c,
            "net.h": "#define NET_N_IN 1\n#define NET_N_OUT 1\nvoid net_eval(const float *x, float *y);\n"}
-    adapter = arm.render_adapter("network", entry="net", header="net.h",
-                                 n_in_macro="NET_N_IN", n_out_macro="NET_N_OUT")
+    adapter = arm.render_adapter("records", entry="net", header="net.h", step="net_eval", init="",
+                                 layout_checks=["NET_N_IN == 1"], input_words=1, output_words=1, state_words=0)
     return src, adapter
 
 
@@ -107,8 +114,9 @@ void ctr_step(ctr_state *s, const ctr_input *in, ctr_output *out)
 
 
 def test_stateful_adapter_startup_and_reset():
-    adapter = arm.render_adapter("stateful", entry="ctr", header="ctr.h", state_t="ctr_state",
-                                 input_t="ctr_input", output_t="ctr_output")
+    adapter = arm.render_adapter("sequence", entry="ctr", header="ctr.h", step="ctr_step", init="ctr_init",
+                                 layout_checks=["sizeof(ctr_state) == 8u", "offsetof(ctr_output, calls) == 8u"],
+                                 input_words=1, output_words=3, state_words=2)
     build = arm.build({"ctr.h": STATEFUL_H, "ctr.c": STATEFUL_C}, adapter)
     image = Image(build.elf)
     machine = Machine(image)
@@ -124,11 +132,21 @@ def test_stateful_adapter_startup_and_reset():
     np.testing.assert_array_equal(run(), [[2.0, 1, 4], [3.0, 2, 5], [3.5, 3, 6]])
 
 
+def test_a_layout_check_that_fails_stops_the_build():
+    """The adapters carry the unit's sizeof/offsetof checks: a dtype that drifted from its C struct
+    cannot be built (negative array size at compile time)."""
+    adapter = arm.render_adapter("sequence", entry="ctr", header="ctr.h", step="ctr_step", init="ctr_init",
+                                 layout_checks=["sizeof(ctr_state) == 12u"], input_words=1, output_words=3,
+                                 state_words=2)
+    with pytest.raises(FirmwareError, match="adapter.c does not compile"):
+        arm.build({"ctr.h": STATEFUL_H, "ctr.c": STATEFUL_C}, adapter)
+
+
 def test_batches_larger_than_the_arena(net12):
-    h = arm.network_arm(net12)
-    n = h.harness.capacity * 2 + 7
+    unit = NetworkUnit(net12)
+    n = Harness(arm_build(unit).elf).capacity * 2 + 7
     x = vectors.gate_vectors(net12.envelope, n, 9).x
-    assert bitcompare.compare(golden.network_eval(net12, x), h.eval(x)).ok
+    assert bitcompare.compare(golden.network_eval(net12, x), evaluate(unit, "arm", x)).ok
 
 
 def test_unknown_adapter_and_non_harness_elf(tmp_path):
@@ -149,7 +167,7 @@ def test_cycles_cli_json_report(net12, tmp_path, capsys):
     report = json.loads(out_json.read_text())
     assert list(report) == ["entries"] and list(report["entries"]) == ["network"]
     entry = report["entries"]["network"]
-    assert set(entry) == {"cycles", "flash_bytes", "ram_bytes", "stack_bytes", "functions"}
+    assert {"cycles", "by_class", "flash_bytes", "ram_bytes", "stack_bytes", "functions", "budgets"} <= set(entry)
     for mode in ("ideal", "art", "pessimistic"):
         s = entry["cycles"][mode]
         assert 0 < s["min"] <= s["median"] <= s["max"]

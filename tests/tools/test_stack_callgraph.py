@@ -2,15 +2,16 @@
 import pytest
 
 from codegen import artifact as art
-from firmware import arm
+from codegen.units.network.unit import NetworkUnit
 from tools import stack
 from tools.m4.elf import Image
+from tools.runners import arm_build
 
 
 @pytest.fixture(scope="module")
 def network_image():
     a = art.random_artifact((12, 40, 3), seed=3)
-    build = arm.network_build(a)
+    build = arm_build(NetworkUnit(a))
     return Image(build.elf), build
 
 

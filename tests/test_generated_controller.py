@@ -1,16 +1,17 @@
-"""The generated controller in the loop: SIL (x86) and PIL (emulated Cortex-M4) vs the float64 twin."""
+"""The generated controller in the loop (host.generated_controller through tools.inloop): SIL (x86) and
+PIL (emulated Cortex-M4) vs the float64 twin, and step for step against the golden model."""
 import numpy as np
 import pytest
 
 from codegen.units.controller import spec as cs
-from codegen.units.controller import golden as gc
-from host import controller_gate as gate
+from codegen.units.controller.unit import ControllerUnit
 from host.cli import main
 from host.controllers import build_controller
 from host.metrics import staring_metrics
 from host.nn_controller import flight_config, load_artifact
 from host.simulator import SimConfig, simulate
 from host.targets import central_target
+from tools.gate import compare_fields
 
 TG = central_target()
 DURATION = 100.0
@@ -51,31 +52,31 @@ def test_sil_matches_the_float64_twin_within_1_percent(twin_run, sil_run):
 
 def test_sil_steps_equal_the_golden_model_bit_for_bit(artifact_file, sil_run):
     c, _, _ = sil_run
-    inputs, outputs = c.trace.arrays()
-    assert inputs.size == int(DURATION / 0.1)
-    golden = gc.run_sequences(load_artifact(artifact_file), flight_config(), inputs[None, :])[0]
-    assert gate.compare_outputs(golden, outputs) == []
+    inputs, outputs = c.loop.trace()
+    assert inputs.size == int(DURATION / 0.1) and c.loop.mismatch_steps == 0
+    golden = ControllerUnit(load_artifact(artifact_file), flight_config()).golden_sequences(inputs[None, :])[0]
+    assert compare_fields(golden, outputs) == []
 
 
 def test_pid_c_matches_the_float64_pid_within_1_percent(artifact_file):
     _, h_ref, m_ref = fly("pid", None)
     c, h, m = fly("pid-c", artifact_file)
     assert set(h.mode) == {"pid"}
-    assert np.all(c.trace.arrays()[1]["status"] & cs.STATUS_PID)
+    assert np.all(c.loop.trace()[1]["status"] & cs.STATUS_PID) and c.loop.mismatch_steps == 0
     assert_within_1pct(m, m_ref)
 
 
 def test_pil_equals_sil_step_for_step_and_records_cycles(artifact_file, sil_run):
     duration = 30.0
     c_pil, h_pil, _ = fly("nn-arm", artifact_file, duration)
-    sil_in, sil_out = sil_run[0].trace.arrays()
-    pil_in, pil_out = c_pil.trace.arrays()
+    sil_in, sil_out = sil_run[0].loop.trace()
+    pil_in, pil_out = c_pil.loop.trace()
     n = pil_in.size
     assert n == int(duration / 0.1)
     # same closed loop: identical inputs, identical outputs, at every step
     assert np.array_equal(pil_in.view(np.uint8), sil_in[:n].view(np.uint8))
-    assert gate.compare_outputs(sil_out[:n], pil_out) == []
-    cycles = np.array(c_pil.trace.cycles)
+    assert compare_fields(sil_out[:n], pil_out) == [] and c_pil.loop.mismatch_steps == 0
+    cycles = np.array(c_pil.loop.cycles)
     assert cycles.size == n and 2_000 < cycles.min() and cycles.max() < 20_000
 
 

@@ -10,9 +10,14 @@ import pytest
 import host.cli as cli
 from codegen import GENERATOR_VERSION
 from codegen import artifact as art
-from codegen.units.network import emit
+from codegen.cgen import c_float, write_sources
 from codegen.errors import CodegenError
+from codegen.units.network import emit
+from codegen.units.network.unit import NetworkUnit
 from firmware import flags, x86
+from firmware.errors import FirmwareError
+from tools.cycles import profile_entry
+from tools.runners import X86Runner, arm_build, pack
 
 LIBM = {"tanhf", "tanh", "expf", "exp", "logf", "log", "sinf", "sin", "cosf", "cos", "atan2f", "atan2",
         "asinf", "asin", "sqrtf", "sqrt", "powf", "pow", "fabsf", "floorf", "expm1f", "__expf_finite"}
@@ -70,7 +75,7 @@ def test_constants_are_exact_and_in_consumption_order(artifact, sources):
 
 def test_c_float_literals_round_trip():
     for v in (0.1, -1.2, 1e-45, -0.0, 3.4028234663852886e38, 2.0 ** -126):
-        text = emit.c_float(v)
+        text = c_float(v)
         assert text.endswith("f")
         back = np.float32(float.fromhex(text[:-1]))
         assert back.view(np.uint32) == np.float32(v).view(np.uint32), text
@@ -95,7 +100,7 @@ def nm(obj) -> dict[str, str]:
 
 
 def test_x86_objects_reference_no_libm_no_malloc_no_mutable_globals(artifact):
-    build = x86.network_library(artifact).build
+    build = X86Runner(NetworkUnit(artifact)).build
     objects = {o.name: nm(o) for o in build.objects}
     assert set(objects) == {"network.o", "sg_math.o"}
     undefined = {s for table in objects.values() for s, t in table.items() if t == "U"}
@@ -121,7 +126,7 @@ def test_arm_build_is_clean_and_the_mlp_loop_does_not_spill(artifact, tmp_path):
     """Cortex-M4: inputs and accumulators stay in registers (no spill), one vldr+vmul+vadd per MAC,
     tanh inlined (its only call is the out-of-range one), a neuron's weights loaded back to back."""
     assert shutil.which(flags.ARM_CC), f"{flags.ARM_CC} missing: run tools/setup.sh"
-    emit.emit(artifact, tmp_path)
+    write_sources(emit.network_sources(artifact), tmp_path)
     asm = arm_compile(tmp_path, tmp_path / "network.s", "-S").read_text()
     body = asm[asm.index("network_mlp:"):asm.index(".size\tnetwork_mlp")]
     assert "[sp" not in body  # no spills (the prologue uses push/vpush, not sp-relative access)
@@ -150,14 +155,11 @@ NETWORK_BUDGET_CYCLES = 3500
 def test_network_path_worst_case_cycles_within_budget():
     """Cycle model, ideal mode: the 50 vectors of each input class (inside, edges, outside,
     special values: saturated and non-finite rows take sg_tanhf's out-of-line path)."""
-    from firmware import arm
-    from host.cli.cycles import class_vectors
-    from tools.cycles import profile_entry
-
     a = art.random_artifact((12, 40, 3), seed=1)
-    classes = class_vectors(a.envelope, 50, 0)
-    records = {c: x.view(np.uint8).reshape(x.shape[0], -1) for c, x in classes.items()}
-    prof = profile_entry(arm.network_build(a).elf, "network_eval", records, ("ideal",))
+    unit = NetworkUnit(a)
+    classes = unit.cycle_classes(50, 0)
+    records = {c: pack(unit, b).view(np.uint8).reshape(b.input.shape[0], -1) for c, b in classes.items()}
+    prof = profile_entry(arm_build(unit).elf, "network_eval", records, ("ideal",))
     worst = {c: by_mode["ideal"]["max"] for c, by_mode in prof.by_class.items()}
     assert prof.cycles["ideal"]["max"] <= NETWORK_BUDGET_CYCLES, worst
     # the special class reached sg_tanhf once per hidden neuron (the out-of-line path is measured)
@@ -176,9 +178,6 @@ def test_cli_codegen_writes_the_four_files(monkeypatch, capsys, tmp_path, artifa
 
 def test_x86_build_refuses_flight_code_that_calls_libm(tmp_path):
     """Inside the Python process a tanhf call would silently bind to the host libm: refused."""
-    from firmware import x86
-    from firmware.errors import FirmwareError
-
     src = tmp_path / "src"
     src.mkdir()
     (src / "bad.c").write_text("float tanhf(float);\nfloat f(float x);\nfloat f(float x) { return tanhf(x); }\n")

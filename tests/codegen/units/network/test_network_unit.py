@@ -1,22 +1,17 @@
 """Bit-exact gate: golden model == x86 C on uint32 bit patterns; the gate's own sensitivity;
 vector coverage; golden vs float64 reference bound; x86 build cache; c-eval / verify CLI."""
 import inspect
-import os
-import subprocess
-import sys
-import textwrap
 
 import numpy as np
 import pytest
 
 import host.cli as cli
+import tools.gate
 from codegen import artifact as art
-from codegen.units.network import reference
 from codegen import bitcompare
-from codegen.units.network import golden, vectors
-from firmware import x86
-from firmware.errors import FirmwareError
-from host.cli import c_eval
+from codegen.units.network import golden, reference, vectors
+from codegen.units.network.unit import NetworkUnit
+from tools.runners import X86Runner
 
 GATE_VECTORS = 20_000
 # Golden vs the float64 reference of the same network, in-envelope inputs: |error| <= this
@@ -24,16 +19,42 @@ GATE_VECTORS = 20_000
 REFERENCE_BOUND = 1e-6
 
 
+class X86Network:
+    """The network unit's x86 build on float32 rows (N, n): the path and each stage."""
+
+    def __init__(self, a):
+        self.run = X86Runner(NetworkUnit(a))
+
+    def _stage(self, name, x):
+        rec = np.zeros(x.shape[0], dtype=self.run.unit.stages[name].input)
+        rec["x"] = x
+        return np.ascontiguousarray(self.run.stage(name, rec)["y"])
+
+    def eval(self, x):
+        rec = np.zeros(x.shape[0], dtype=self.run.unit.input_dtype)
+        rec["x"] = x
+        return np.ascontiguousarray(self.run.sequence(rec)["y"])
+
+    def normalise(self, x):
+        return self._stage("normalise", x)
+
+    def mlp(self, x):
+        return self._stage("mlp", x)
+
+    def denormalise(self, x):
+        return self._stage("denormalise", x)
+
+
 @pytest.fixture(scope="module")
 def net12():
     a = art.random_artifact((12, 40, 3), seed=1)
-    return a, x86.network_library(a)
+    return a, X86Network(a)
 
 
 @pytest.fixture(scope="module")
 def net5():
     a = art.random_artifact((5, 17, 2), seed=1)
-    return a, x86.network_library(a)
+    return a, X86Network(a)
 
 
 def assert_bits_equal(expected, actual):
@@ -145,60 +166,6 @@ def test_vector_classes_hold_for_synthetic_envelopes(shape):
     assert not inside[vs.kind == vectors.OUTSIDE].any()
 
 
-def test_bitcompare_nan_is_a_class_signed_zero_is_not():
-    x86_nan = np.uint32([0xFFC00000]).view(np.float32)
-    arm_nan = np.uint32([0x7FC00000]).view(np.float32)
-    assert bitcompare.compare(x86_nan, arm_nan).ok
-    result = bitcompare.compare(np.float32([[0.0, 1.0], [np.nan, 2.0]]), np.float32([[-0.0, 1.0], [3.0, 2.0]]))
-    assert result.n_mismatches == 2 and list(result.mismatched_rows) == [0, 1]
-    assert result.first[0].expected_bits == 0 and result.first[0].actual_bits == 0x80000000
-    assert "0x00000000" in result.report()[1] and "0x80000000" in result.report()[1]
-
-
-# ----------------------------------------------------------------------------- x86 build
-
-SMALL_SOURCES = {"tiny.h": "float tiny_twice(float x);\n",
-                 "tiny.c": '#include "tiny.h"\nfloat tiny_twice(float x) { return x + x; }\n'}
-SMALL_CDEF = "float tiny_twice(float x);"
-SMALL_HARNESS = '#include "tiny.h"'
-
-
-def test_x86_build_is_cached_by_content(monkeypatch, tmp_path):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path))
-    first = x86.build(SMALL_SOURCES, SMALL_CDEF, SMALL_HARNESS)
-    assert first.lib.tiny_twice(1.5) == 3.0
-    assert first.folder.parent == tmp_path / "x86" and first.folder.name == first.key
-    changed = dict(SMALL_SOURCES, **{"tiny.c": SMALL_SOURCES["tiny.c"] + "\n"})
-    assert x86.build_key(changed, SMALL_CDEF, SMALL_HARNESS) != first.key
-    assert [p.name for p in (tmp_path / "x86").iterdir()] == [first.key]  # no temporaries left
-
-
-def test_x86_concurrent_builds_of_one_key_are_safe(tmp_path):
-    script = textwrap.dedent(f"""
-        from firmware import x86
-        b = x86.build({SMALL_SOURCES!r}, {SMALL_CDEF!r}, {SMALL_HARNESS!r})
-        assert b.lib.tiny_twice(2.0) == 4.0
-        print(b.key)
-    """)
-    env = dict(os.environ, STAREGEN_CACHE=str(tmp_path / "cache"), PYTHONPATH=os.getcwd())
-    procs = [subprocess.Popen([sys.executable, "-c", script], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                              text=True) for _ in range(2)]
-    results = [p.communicate(timeout=120) + (p.returncode,) for p in procs]
-    assert all(code == 0 for _, _, code in results), [err for _, err, _ in results]
-    keys = {out.strip() for out, _, _ in results}
-    assert len(keys) == 1 and [p.name for p in (tmp_path / "cache" / "x86").iterdir()] == [keys.pop()]
-
-
-def test_x86_compile_error_and_missing_compiler_are_one_line_firmware_errors(monkeypatch, tmp_path):
-    monkeypatch.setenv("STAREGEN_CACHE", str(tmp_path))
-    broken = {"tiny.h": SMALL_SOURCES["tiny.h"], "tiny.c": "float tiny_twice(float x) { return x + 1.0; }\n"}
-    with pytest.raises(FirmwareError) as info:
-        x86.build(broken, SMALL_CDEF, SMALL_HARNESS)  # -Wdouble-promotion -Werror
-    assert "tiny.c does not compile" in str(info.value) and "\n" not in str(info.value)
-    with pytest.raises(FirmwareError, match="not found"):
-        x86.build(SMALL_SOURCES, SMALL_CDEF, SMALL_HARNESS, cc="no-such-cc-staregen")
-
-
 # ----------------------------------------------------------------------------- CLI
 
 def run_cli(monkeypatch, capsys, *argv):
@@ -242,21 +209,26 @@ def test_cli_verify_passes_and_reports(monkeypatch, capsys, tmp_path, net12):
     code, out, _ = run_cli(monkeypatch, capsys, "verify", "--artifact", path, "--target", "x86",
                            "--vectors", 5_000, "--seed", 4)
     assert code == 0
-    assert "x86 vs golden: 0 mismatches in 15000 values" in out
+    assert "x86 vs golden" in out and "identical" in out and "inside 3250" in out
     assert "golden vs float64 reference" in out and "PASS" in out and "total" in out
 
 
 def test_cli_verify_exits_non_zero_on_a_mismatch(monkeypatch, capsys, tmp_path, net12):
     a = net12[0]
+    real = tools.gate.runner
 
-    def flipped(artifact):
-        def evaluate(x):
-            y = golden.network_eval(artifact, x)
-            y.view(np.uint32)[10, 1] ^= 1  # one bit of one output
-            return y
-        return evaluate
+    class Flipped:
+        """The real x86 runner with one bit of one output flipped."""
 
-    monkeypatch.setitem(c_eval.EVALUATORS, "x86", flipped)
+        def __init__(self, unit, target):
+            self.inner = real(unit, target)
+
+        def records(self, batch):
+            out, state = self.inner.records(batch)
+            out["y"].view(np.uint32)[10, 1] ^= 1
+            return out, state
+
+    monkeypatch.setattr(tools.gate, "runner", Flipped)
     code, out, _ = run_cli(monkeypatch, capsys, "verify", "--artifact", a.save(tmp_path / "a.json"),
                            "--target", "x86", "--vectors", 1_000)
     assert code == 1 and "1 mismatches" in out and "row 10 col 1" in out and "FAIL" in out

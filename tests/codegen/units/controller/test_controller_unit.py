@@ -1,19 +1,26 @@
-"""The generated controller: golden == x86 C == ARM C bit for bit on the whole step, time base
-accuracy, status bits, and a finite, limited torque for every input pattern."""
+"""The controller unit (paper 001 Fig. 2): golden == x86 C == ARM C bit for bit on the whole step,
+time base accuracy, status bits, and a finite, limited torque for every input pattern. (What every
+unit must do is in tests/codegen/units/test_every_unit.py; this file holds the controller's own.)"""
+import json
 import subprocess
 
 import numpy as np
 import pytest
 
-from codegen.units.controller import spec as cs
+from codegen.unit import Batch
 from codegen.units.controller import golden as gc
-from codegen.units.controller.emit import INPUT_DTYPE, controller_sources, to_bam
+from codegen.units.controller import spec as cs
+from codegen.units.controller import vectors as cv
+from codegen.units.controller.emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, controller_sources, to_bam
+from codegen.units.controller.unit import ControllerUnit
 from firmware import arm
-from firmware.x86_controller import X86Controller
-from host import controller_gate as gate
+from host.cli import main
 from host.constants import ARCSEC, DEG
 from host.nn_controller import flight_config, load_artifact
+from host.scenarios import StaringScenario
 from host.timebase import gmst
+from tools.gate import compare_fields
+from tools.runners import arm_build, layout_checks, runner
 
 N_STEPS = 4000
 N_SEQ, SEQ_STEPS = 3, 1000
@@ -33,18 +40,39 @@ def cfg():
 
 
 @pytest.fixture(scope="module")
-def vectors(cfg):
-    return gate.gate_inputs(N_STEPS, seed=11, dwell=cfg.dwell_steps)
+def scenario():
+    return StaringScenario()
 
 
-def test_three_way_gate_independent_steps(artifact, cfg, vectors):
+@pytest.fixture(scope="module")
+def unit(artifact, cfg, scenario):
+    return ControllerUnit(artifact, cfg, scenario)
+
+
+@pytest.fixture(scope="module")
+def vectors(unit):
+    """(states, inputs, class index) of N_STEPS independent steps in the unit's gate classes."""
+    classes = unit.gate_classes(N_STEPS, seed=11)
+    kind = np.repeat(np.arange(len(classes)), [b.input.size for b in classes.values()])
+    return (np.concatenate([b.state for b in classes.values()]), np.concatenate([b.input for b in classes.values()]),
+            kind)
+
+
+def on_targets(unit, states, inputs):
+    """(outputs, states after) of the x86 and the ARM build."""
+    return [runner(unit, t).records(Batch(states, inputs)) for t in ("x86", "arm")]
+
+
+def same(g_out, g_state, out, st):
+    return compare_fields(g_out, out) == [] and compare_fields(g_state, st) == []
+
+
+def test_three_way_gate_independent_steps(unit, artifact, cfg, vectors):
     states, inputs, kind = vectors
+    assert list(unit.gate_classes(100, 0)) == list(cv.KINDS)
     g_out, g_state = gc.step(artifact, cfg, states, inputs)
-    x_out, x_state = X86Controller(artifact, cfg).run_records(states, inputs)
-    a_out, a_state = gate.ArmRunner(artifact, cfg).run_records(states, inputs)
-    for out, st in ((x_out, x_state), (a_out, a_state)):
-        assert gate.compare_outputs(g_out, out) == []
-        assert gate.compare_states(g_state, st) == []
+    for out, st in on_targets(unit, states, inputs):
+        assert same(g_out, g_state, out, st)
         # uint32 patterns, NaN as a class, on the torque itself
         assert np.array_equal(g_out["torque"].view(np.uint32), out["torque"].view(np.uint32))
     # every class exercised both laws
@@ -54,27 +82,26 @@ def test_three_way_gate_independent_steps(artifact, cfg, vectors):
     assert invalid[kind == 2].mean() > 0.3 and pid[invalid].all() and not invalid[kind == 0].any()
 
 
-def test_corrupted_integrator_is_repaired_and_flagged(artifact, cfg, vectors):
+def test_corrupted_integrator_is_repaired_and_flagged(unit, artifact, cfg, vectors):
     """A NaN/Inf/huge integrator in the caller's state restarts at 0 with a status bit (all targets)."""
     _, inputs, kind = vectors
-    rows = np.flatnonzero(kind == 0)[:len(gate.CORRUPT_INTEGRALS) * 3]
+    rows = np.flatnonzero(kind == 0)[:len(cv.CORRUPT_INTEGRALS) * 3]
     states = gc.init(rows.size)
     states["mode"] = 1  # the PID flies: a silenced axis would show in the torque
     for k in range(rows.size):
-        states["integral"][k, k % 3] = gate.CORRUPT_INTEGRALS[k // 3]
+        states["integral"][k, k % 3] = cv.CORRUPT_INTEGRALS[k // 3]
     g_out, g_state = gc.step(artifact, cfg, states, inputs[rows])
     assert np.all(g_out["status"] & cs.STATUS_STATE_REPAIRED)
     assert np.all(np.isfinite(g_out["torque"])) and np.all(np.abs(g_out["torque"]) <= cfg.torque_limit)
     assert np.all(np.abs(g_state["integral"]) <= cfg.integral_limit)
-    for out, st in (X86Controller(artifact, cfg).run_records(states, inputs[rows]),
-                    gate.ArmRunner(artifact, cfg).run_records(states, inputs[rows])):
-        assert gate.compare_outputs(g_out, out) == [] and gate.compare_states(g_state, st) == []
+    for out, st in on_targets(unit, states, inputs[rows]):
+        assert same(g_out, g_state, out, st)
     # healthy states never raise it
     healthy, _ = gc.step(artifact, cfg, gc.init(rows.size), inputs[rows])
     assert not np.any(healthy["status"] & cs.STATUS_STATE_REPAIRED)
 
 
-def test_latitude_beyond_90_degrees_is_an_invalid_input(artifact, cfg, vectors):
+def test_latitude_beyond_90_degrees_is_an_invalid_input(unit, artifact, cfg, vectors):
     """lat outside [-2^30, 2^30] (binary angle) would aim at the mirrored latitude: refused."""
     _, inputs, kind = vectors
     rows = np.flatnonzero(kind == 0)[:8]
@@ -84,25 +111,25 @@ def test_latitude_beyond_90_degrees_is_an_invalid_input(artifact, cfg, vectors):
     g_out, g_state = gc.step(artifact, cfg, states, inp)
     assert np.all(g_out["status"] & cs.STATUS_INPUT_INVALID) and np.all(g_out["status"] & cs.STATUS_PID)
     assert np.all(g_out["torque"] == 0.0)  # Table 1 PID on zeroed errors (Ki = 0)
-    for out, st in (X86Controller(artifact, cfg).run_records(states, inp),
-                    gate.ArmRunner(artifact, cfg).run_records(states, inp)):
-        assert gate.compare_outputs(g_out, out) == [] and gate.compare_states(g_state, st) == []
+    for out, st in on_targets(unit, states, inp):
+        assert same(g_out, g_state, out, st)
     # exactly +-90 deg is a valid latitude
     inp["lat"] = np.where(np.arange(rows.size) % 2 == 0, cs.LAT_BAM_MAX, -cs.LAT_BAM_MAX)
     edge, _ = gc.step(artifact, cfg, states, inp)
     assert not np.any(edge["status"] & cs.STATUS_INPUT_INVALID)
 
 
-def test_three_way_gate_sequences_with_mode_switches(artifact, cfg):
-    seqs = gate.sequence_inputs(N_SEQ, SEQ_STEPS, seed=5)
-    g = gc.run_sequences(artifact, cfg, seqs)
+def test_three_way_gate_sequences_with_mode_switches(unit):
+    seqs = unit.gate_sequences(N_SEQ, SEQ_STEPS, seed=5)
+    g = unit.golden_sequences(seqs)
     switches = np.sum(np.diff((g["status"] & cs.STATUS_PID) != 0, axis=1))
     assert switches >= 20
-    x86, arm_ = X86Controller(artifact, cfg), gate.ArmRunner(artifact, cfg)
+    x86, arm_ = runner(unit, "x86"), runner(unit, "arm")
     for s in range(N_SEQ):
         x86.reset()
-        assert gate.compare_outputs(g[s], x86.run_sequence(seqs[s])) == []
-        assert gate.compare_outputs(g[s], arm_.run_sequence(seqs[s])) == []
+        arm_.reset()
+        assert compare_fields(g[s], x86.sequence(seqs[s])) == []
+        assert compare_fields(g[s], arm_.sequence(seqs[s])) == []
 
 
 def test_a_changed_operation_is_caught(artifact, cfg, vectors):
@@ -110,57 +137,58 @@ def test_a_changed_operation_is_caught(artifact, cfg, vectors):
     states, inputs, _ = vectors
     other = cfg.__class__(**{**cfg.__dict__, "kd": (46.0, 77.0, 50.5)})
     g_out, _ = gc.step(artifact, cfg, states, inputs)
-    x_out, _ = X86Controller(artifact, other).run_records(states, inputs)
-    assert gate.compare_outputs(g_out, x_out) != []
+    x_out, _ = runner(ControllerUnit(artifact, other), "x86").records(Batch(states, inputs))
+    assert compare_fields(g_out, x_out) != []
 
 
-def test_torque_finite_and_limited_for_special_values_in_every_field(artifact, cfg):
+def test_torque_finite_and_limited_for_special_values_in_every_field(unit, artifact, cfg, scenario):
     rng = np.random.default_rng(2)
-    base = gate.make_inputs(gate.random_geometry(rng, 1), np.zeros((1, 3)), np.zeros((1, 3)))
+    base = scenario.inputs(scenario.geometry(rng, 1), np.zeros((1, 3)), np.zeros((1, 3)))
     rows = []
-    for f in gate.FLOAT_FIELDS:
+    for f in cv.FLOAT_FIELDS:
         for i in range(3):
-            for v in gate.SPECIAL_F32:
+            for v in cv.SPECIAL_F32:
                 r = base.copy()
                 r[f][0, i] = v
                 rows.append(r)
     for f in ("utc_day", "utc_ms", "lon", "lat"):
-        for v in gate.INT_SPECIAL:
+        for v in cv.INT_SPECIAL:
             r = base.copy()
             r[f] = np.int64(v).astype(np.int32) if f in ("lon", "lat") else np.clip(v, -2**31, 2**31 - 1)
             rows.append(r)
     bits = rng.integers(0, 2**32, (3000, INPUT_DTYPE.itemsize // 4), dtype=np.uint64).astype(np.uint32)
     inputs = np.concatenate([*rows, bits.view(INPUT_DTYPE).reshape(-1)])
-    states = gate.random_states(rng, inputs.size, cfg.dwell_steps)
+    states = cv.random_states(rng, inputs.size, cfg.dwell_steps)
     g_out, _ = gc.step(artifact, cfg, states, inputs)
-    x_out, _ = X86Controller(artifact, cfg).run_records(states, inputs)
-    assert gate.compare_outputs(g_out, x_out) == []
-    assert gate.torque_problems(x_out, cfg.torque_limit) == []
+    x_out, _ = runner(unit, "x86").records(Batch(states, inputs))
+    assert compare_fields(g_out, x_out) == []
+    assert unit.check_outputs(x_out) == []
     invalid = (x_out["status"][:len(rows)] & cs.STATUS_INPUT_INVALID) != 0
-    nonfinite = ~np.all(np.isfinite(np.stack([inputs[f][:len(rows)] for f in gate.FLOAT_FIELDS], 1).reshape(len(rows), -1)), 1)
+    nonfinite = ~np.all(np.isfinite(np.stack([inputs[f][:len(rows)] for f in cv.FLOAT_FIELDS], 1).reshape(len(rows), -1)), 1)
     assert np.all(invalid[nonfinite])
 
 
-def test_status_bits_name_the_crossed_bound(artifact, cfg):
+def test_status_bits_name_the_crossed_bound(artifact, cfg, scenario):
     rng = np.random.default_rng(4)
-    geo = gate.random_geometry(rng, 6)
+    geo = scenario.geometry(rng, 6)
     A, w = np.zeros((6, 3)), np.zeros((6, 3))
     for k in range(6):
         (A if k < 3 else w)[k, k % 3] = (-1) ** k * (0.0202 if k < 3 else 0.00404) * DEG
-    out, _ = gc.step(artifact, cfg, gc.init(6), gate.make_inputs(geo, A, w))
+    out, _ = gc.step(artifact, cfg, gc.init(6), scenario.inputs(geo, A, w))
     for k in range(6):
         assert out["status"][k] & cs.STATUS_BOUNDS_MASK == 1 << (cs.STATUS_BOUND_SHIFT + 6 + k)
         assert out["status"][k] & cs.STATUS_PID
 
 
-def test_dwell_and_hand_back_in_the_c(artifact, cfg):
+def test_dwell_and_hand_back_in_the_c(unit, scenario):
     rng = np.random.default_rng(6)
-    geo = gate.random_geometry(rng, 1)
-    clean = gate.make_inputs(geo, np.zeros((1, 3)), np.zeros((1, 3)))
-    bad = gate.make_inputs(geo, np.array([[0.03 * DEG, 0, 0]]), np.zeros((1, 3)))
+    geo = scenario.geometry(rng, 1)
+    clean = scenario.inputs(geo, np.zeros((1, 3)), np.zeros((1, 3)))
+    bad = scenario.inputs(geo, np.array([[0.03 * DEG, 0, 0]]), np.zeros((1, 3)))
     seq = np.concatenate([clean, bad, *([clean] * 12)])
-    c = X86Controller(artifact, cfg)
-    modes = (c.run_sequence(seq)["status"] & cs.STATUS_PID) != 0
+    c = runner(unit, "x86")
+    c.reset()
+    modes = (c.sequence(seq)["status"] & cs.STATUS_PID) != 0
     assert modes.tolist() == [False, True] + [True] * 9 + [False] * 3
 
 
@@ -187,34 +215,20 @@ def test_binary_angles_round_trip():
     np.testing.assert_allclose(bam[1:5] * np.pi / 2**31, lon[1:5], atol=np.pi / 2**31)
 
 
-def test_arm_image_has_no_soft_double_and_no_libm(artifact, cfg):
-    from host.sil import controller_arm_build
-
-    build = controller_arm_build(artifact, cfg)
+def test_arm_image_has_no_soft_double_and_no_libm(unit):
+    build = arm_build(unit, "sequence")
     arm.check_symbols(build.elf)
     names = subprocess.run([arm.tool(arm.ARM_NM), str(build.elf)], capture_output=True, text=True).stdout
     assert "__aeabi_d" not in names and "__aeabi_f2d" not in names and "__aeabi_l" not in names
     assert not build.newlib
 
 
-def test_golden_model_uses_no_numpy_math_and_no_reordering_sums():
-    import ast
-    import inspect
-
-    tree = ast.parse(inspect.getsource(gc))
-    used = {n.attr for n in ast.walk(tree) if isinstance(n, ast.Attribute)}
-    banned = {"tanh", "sin", "cos", "exp", "log", "arctan2", "arcsin", "sqrt", "dot", "sum", "matmul", "einsum"}
-    assert not (used & banned), used & banned
-    assert not any(isinstance(n, ast.BinOp) and isinstance(n.op, ast.MatMult) for n in ast.walk(tree))
-
-
-def test_cffi_structs_match_the_record_layouts(artifact, cfg):
-    from codegen.units.controller.emit import OUTPUT_DTYPE, STATE_DTYPE
-
-    c = X86Controller(artifact, cfg)
-    assert c.ffi.sizeof("controller_input_t") == INPUT_DTYPE.itemsize == 64
-    assert c.ffi.sizeof("controller_output_t") == OUTPUT_DTYPE.itemsize == 40
-    assert c.ffi.sizeof("controller_state_t") == STATE_DTYPE.itemsize == 20
+def test_record_dtypes_are_the_c_structs(unit):
+    """Sizes as documented; the cffi wrapper and the ARM adapters refuse to build otherwise."""
+    assert (INPUT_DTYPE.itemsize, OUTPUT_DTYPE.itemsize, STATE_DTYPE.itemsize) == (64, 40, 20)
+    checks = layout_checks(unit)
+    assert "sizeof(controller_input_t) == 64u" in checks and "offsetof(controller_output_t, status) == 12u" in checks
+    assert "offsetof(controller_input_t, lon) == 48u" in checks and "offsetof(controller_state_t, clean) == 16u" in checks
 
 
 def test_sources_are_deterministic_and_share_the_network_templates(artifact, cfg):
@@ -225,17 +239,13 @@ def test_sources_are_deterministic_and_share_the_network_templates(artifact, cfg
 
 
 def test_verify_and_cycles_commands(artifact, tmp_path, capsys):
-    import json
-
-    from host.cli import main
-
     path = tmp_path / "a.json"
     artifact.save(path)
-    assert main(["verify", "--artifact", str(path), "--target", "all", "--controller",
+    assert main(["verify", "--unit", "controller", "--artifact", str(path), "--target", "all",
                  "--vectors", "600", "--sequences", "1"]) == 0
     assert "PASS" in capsys.readouterr().out
     report = tmp_path / "c.json"
-    assert main(["cycles", "--entry", "controller", "--artifact", str(path), "--per-class", "4",
+    assert main(["cycles", "--unit", "controller", "--artifact", str(path), "--per-class", "4",
                  "--json", str(report)]) == 0
     rep = json.loads(report.read_text())["entries"]["controller"]
     assert set(rep["by_class"]) == {"nn_path", "pid_path", "dwell", "invalid", "bits"}

@@ -8,14 +8,15 @@ import numpy as np
 import pytest
 
 from codegen import artifact as art
+from codegen.unit import Batch
 from codegen.units.network import golden
-from codegen.units.controller.emit import INPUT_DTYPE, STATE_DTYPE
+from codegen.units.network.unit import NetworkUnit
 from firmware import x86
 from firmware.errors import FirmwareError
-from firmware.x86_controller import X86Controller
 from host import tanh_example as ex
-from host.nn_controller import flight_config, load_artifact
-from host.tanh_sil import X86Tanh
+from host.nn_controller import load_artifact
+from host.scenarios import configure_unit
+from tools.runners import X86Runner
 
 CONTROL = 0xFFC0  # MXCSR control bits; bits 0-5 are sticky exception flags that float code sets
 
@@ -28,9 +29,22 @@ def artifact():
     return art.random_artifact((5, 17, 2), seed=4)
 
 
+class Net:
+    """The network unit's x86 runner on float32 rows."""
+
+    def __init__(self, artifact):
+        self.run = X86Runner(NetworkUnit(artifact))
+        self.build = self.run.build
+
+    def eval(self, x):
+        rec = np.zeros(x.shape[0], dtype=self.run.unit.input_dtype)
+        rec["x"] = x
+        return np.ascontiguousarray(self.run.records(Batch(None, rec))[0]["y"])
+
+
 @pytest.fixture(scope="module")
 def net(artifact):
-    return x86.network_library(artifact)
+    return Net(artifact)
 
 
 @contextlib.contextmanager
@@ -76,16 +90,14 @@ def test_every_set_bit_is_named(net):
     assert "(FTZ)" in str(info.value) and "(DAZ)" in str(info.value)
 
 
-def test_tanh_and_controller_batches_are_guarded():
-    tanh = X86Tanh(ex.paper_parameters())
-    ctrl = X86Controller(load_artifact(None), flight_config())
-    calls = [
-        (tanh.build, lambda: tanh.step(np.zeros((1, 3), np.float32), np.zeros((1, 27), np.float32))),
-        (tanh.build, lambda: tanh.sequence(np.zeros((1, 27), np.float32))),
-        (ctrl.build, lambda: ctrl.run_records(np.zeros(1, STATE_DTYPE), np.zeros(1, INPUT_DTYPE))),
-        (ctrl.build, lambda: ctrl.run_sequence(np.zeros(1, INPUT_DTYPE))),
-    ]
-    for build, call in calls:
-        with mxcsr(build, x86.MXCSR_FTZ), pytest.raises(FirmwareError, match="FTZ"):
+@pytest.mark.parametrize("kind", ["controller", "tanh"])
+def test_stateful_units_records_and_sequences_are_guarded(kind):
+    inputs = {"artifact": load_artifact(None)} if kind == "controller" else {"params": ex.paper_parameters()}
+    run = X86Runner(configure_unit(kind, **inputs))
+    unit = run.unit
+    calls = [lambda: run.records(Batch(unit.init_state(1), np.zeros(1, unit.input_dtype))),
+             lambda: run.sequence(np.zeros(1, unit.input_dtype))]
+    for call in calls:
+        with mxcsr(run.build, x86.MXCSR_FTZ), pytest.raises(FirmwareError, match="FTZ"):
             call()
         call()

@@ -9,7 +9,9 @@ import pytest
 
 import host.cli as cli
 from host import tanh_example as ex
-from host import tanh_sil
+from host import tanh_in_loop
+from host.scenarios import configure_unit
+from tools.report import cycle_report, cycle_text
 
 PERIOD, DURATION, DT = 0.1, 40.0, 5e-4
 # Measured (docs/tanh-controller.md, "Generated C"): the C and float64 runs agree to 3.2e-7 in ‖e‖
@@ -26,12 +28,12 @@ def reference():
 
 @pytest.fixture(scope="module")
 def sil(reference):
-    return tanh_sil.run_in_loop("x86", PERIOD, DURATION, DT, reference=reference)
+    return tanh_in_loop.run_in_loop("x86", PERIOD, DURATION, DT, reference=reference)
 
 
 @pytest.fixture(scope="module")
 def pil(reference):
-    return tanh_sil.run_in_loop("arm", PERIOD, DURATION, DT, reference=reference)
+    return tanh_in_loop.run_in_loop("arm", PERIOD, DURATION, DT, reference=reference)
 
 
 @pytest.mark.parametrize("run", ["sil", "pil"])
@@ -78,10 +80,11 @@ def test_pil_reports_cycles_per_step(pil):
 
 def test_cycle_report_of_tanh_step():
     """SPEC 8 budget on the gate's classes (250 vectors each, the CLI's default) plus the example."""
-    rep = tanh_sil.cycle_report(ex.paper_parameters(), per_class=250)
+    unit = configure_unit("tanh", params=ex.paper_parameters())
+    rep = cycle_report(unit, ("ideal",), per_class=250, seed=0)
     assert set(rep["by_class"]) == {"random", "small", "delta", "singular", "off_so3", "extreme", "special",
                                     "example"}
-    assert rep["cycles"]["ideal"]["max"] <= tanh_sil.BUDGET_CYCLES == 1_500
+    assert rep["cycles"]["ideal"]["max"] <= unit.budgets.cycles == 1_500
     assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
     # 13,664 B measured, of which 2 x 1,544 B the two sg_powc_t tables
     assert 0 < rep["flash_bytes"] <= 14 * 1024 and rep["ram_bytes"] == 0 and not rep["newlib"]
@@ -90,8 +93,8 @@ def test_cycle_report_of_tanh_step():
     assert {"sg_tanhf", "tanh_step"} <= set(rep["functions"])
     assert not {"sg_expf", "sg_logf", "sg_powf_pos"} & set(rep["functions"])
     assert rep["functions"]["sg_tanhf"]["calls"]["max"] == 6
-    text = "\n".join(tanh_sil.cycle_text(rep))
-    assert "budget (SPEC 8), tanh law step worst case ideal: within budget" in text
+    text = "\n".join(cycle_text(rep))
+    assert "budget (SPEC 8), step worst case ideal: within budget" in text
 
 
 def test_simulate_cli_runs_the_c_in_the_loop(tmp_path, capsys):

@@ -1,0 +1,55 @@
+"""Command-line options shared by every command that works on a generated unit (codegen, verify,
+cycles): `--unit` names a registered unit (codegen.units), the input flags bind it, and the host
+adds its flight configuration and realistic inputs (host.scenarios.configure_unit)."""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from codegen import artifact as art
+from codegen import units
+from codegen.unit import Unit
+from codegen.units.tanh.params import load_params
+from host.cli.args import parse_number
+from host.errors import HostError
+from host.nn_controller import load_artifact
+from host.scenarios import configure_unit
+
+
+def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network") -> None:
+    known = units.kinds()
+    parser.add_argument("--unit", default=default, choices=sorted(known),
+                        help="generated unit: " + "; ".join(f"{k}: {v.summary}" for k, v in sorted(known.items()))
+                        + f" (default {default})")
+    parser.add_argument("--artifact", metavar="FILE", help="model artifact (units network, controller)")
+    parser.add_argument("--params", metavar="FILE", help="parameter file, .toml/.json (unit tanh)")
+    parser.add_argument("--period", default=None, metavar="S", help="control period baked into the unit, s "
+                        "(unit tanh; default 0.1)")
+    parser.add_argument("--name", default=None, help="entry name: files <name>.h/.c, functions <name>_* "
+                        "(default: the unit's name)")
+
+
+def deprecated(old: str, new: str) -> None:
+    print(f"staregen: '{old}' is deprecated and will be removed; use '{new}'", file=sys.stderr)
+
+
+def unit_from_args(args: argparse.Namespace) -> Unit:
+    """The unit of --unit bound to --artifact / --params / --period / --name; user errors are one line."""
+    kind = units.get(args.unit)
+    given = {"artifact": args.artifact, "params": args.params}
+    for flag, value in given.items():
+        if value is not None and flag not in kind.needs:
+            raise HostError(f"--{flag} does not apply to unit {args.unit}")
+    inputs = {"name": args.name}
+    if args.period is not None:
+        if "params" not in kind.needs:
+            raise HostError(f"--period does not apply to unit {args.unit}")
+        inputs["period"] = parse_number(args.period, "--period", positive=True)
+    if args.params is not None:
+        inputs["params"] = load_params(args.params)
+    if args.artifact is not None:
+        inputs["artifact"] = art.load(args.artifact)
+    elif args.unit == "controller":
+        print("unit controller: no --artifact, using the stand-in network fitted to the PID law")
+        inputs["artifact"] = load_artifact(None)
+    return configure_unit(args.unit, **inputs)
