@@ -201,9 +201,11 @@ class UnitKind:
 
     `configure(**inputs)` receives the keyword inputs the CLI or a caller has (artifact=,
     params=, period=, config=, scenario=, name=), takes those it needs and refuses a missing one
-    with a CodegenError."""
+    with a CodegenError. `example()` gives small inputs for the tests written once for every
+    unit (tests/codegen/units/test_every_unit.py): registering a unit is what gets it tested."""
 
     name: str
     summary: str
     needs: tuple[str, ...]
     configure: Callable[..., Unit]
+    example: Callable[[], dict]

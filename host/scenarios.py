@@ -146,6 +146,6 @@ def unit_inputs(kind: str) -> dict:
     return {}
 
 
-def configure_unit(kind: str, **inputs) -> Unit:
+def configure_unit(kind: str, /, **inputs) -> Unit:
     """A registered unit bound to the caller's inputs (artifact=, params=, period=, ...) and the host's."""
     return units.configure(kind, **{**unit_inputs(kind), **{k: v for k, v in inputs.items() if v is not None}})

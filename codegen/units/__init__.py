@@ -56,6 +56,6 @@ def get(name: str) -> UnitKind:
     return known[name]
 
 
-def configure(name: str, **inputs):
-    """The unit `name` bound to its inputs (see UnitKind.configure)."""
-    return get(name).configure(**inputs)
+def configure(kind: str, /, **inputs):
+    """The unit `kind` bound to its inputs (see UnitKind.configure)."""
+    return get(kind).configure(**inputs)

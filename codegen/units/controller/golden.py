@@ -200,7 +200,9 @@ def _inputs_finite(inp: np.ndarray) -> np.ndarray:
 
 def step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndarray):
     """One controller step for each row: (outputs OUTPUT_DTYPE (N,), new state STATE_DTYPE (N,))."""
-    assert state.dtype == STATE_DTYPE and inp.dtype == INPUT_DTYPE and state.shape == inp.shape
+    if state.dtype != STATE_DTYPE or inp.dtype != INPUT_DTYPE or state.shape != inp.shape or inp.ndim != 1:
+        raise ValueError(f"golden controller: state and input must be (N,) {STATE_DTYPE} / {INPUT_DTYPE} "
+                         f"records, got {state.dtype} {state.shape} and {inp.dtype} {inp.shape}")
     with np.errstate(all="ignore"):
         return _step(a, cfg, state, inp)
 

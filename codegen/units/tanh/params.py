@@ -174,3 +174,12 @@ def derived_constants(p: TanhParams) -> dict[str, object]:
         "ua_gain": J_inv_norm * p.d_max,
         "ua_inner_scale": J_inv_norm * p.d_max / p.n1 ** g,
     }
+
+
+def example_params() -> TanhParams:
+    """A valid parameter set for the generic unit tests (not the paper's: docs/tanh_paper000.toml
+    holds those), with other γ, gains and inertia so nothing is tuned to one set of numbers."""
+    return params_from_mapping({
+        "k1": 1.0, "k2": 1.2, "k3": 0.8, "k4": 3.0, "k5": 0.002, "eps1": 20.0, "eps2": 30.0, "eps3": 40.0,
+        "beta1": 0.2, "beta2": 0.4, "gamma": 0.6, "eta": 0.002, "n1": 0.01, "lambda": 0.002, "d_max": 0.003,
+        "inertia": [[3.0, 0.1, 0.0], [0.1, 2.0, -0.2], [0.0, -0.2, 4.0]]})
