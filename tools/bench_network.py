@@ -1,7 +1,7 @@
 """Side-by-side benchmark of the network path on the Cortex-M4 cycle model (issue 4; not a test).
 
 The same 12-40-3 network (an artifact file, e.g. a trained one, or a seeded random one) as
-  * our generated C (codegen.units.network.emit) at -O2 (the flight level), -Os and -O0 (firmware.flags.with_opt),
+  * our generated C (the network unit, codegen/units/network) at -O2 (the flight level), -Os and -O0 (firmware.flags.with_opt),
   * emlearn's C (pip package `emlearn`, optional extra `bench`: its "loadable" MLP, eml_net.h,
     tanhf from newlib's libm), built by firmware/arm.py with peer=True: the same flags minus
     -Werror (its headers are not -Wextra -pedantic clean), libm and newlib-nano linked,
@@ -28,13 +28,15 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from codegen import artifact as art  # noqa: E402
-from codegen import reference  # noqa: E402
-from codegen import golden  # noqa: E402
+from codegen.units.network import golden, reference  # noqa: E402
+from codegen.units.network.unit import NetworkUnit  # noqa: E402
+from codegen.units.network.vectors import class_vectors  # noqa: E402
 from firmware import arm  # noqa: E402
-from host.cli.cycles import class_vectors  # noqa: E402
 from tools import size  # noqa: E402
 from tools.cycles import CLOCK_HZ, profile_entry  # noqa: E402
+from tools.m4.harness import Harness  # noqa: E402
 from tools.m4.profile import MODES  # noqa: E402
+from tools.runners import arm_build  # noqa: E402
 
 PAPER_MS = 3.1                                   # the paper's network path on its M4F
 PAPER_CYCLES = round(PAPER_MS * 1e-3 * CLOCK_HZ)  # 520,800 at 168 MHz
@@ -62,6 +64,12 @@ def _profile(elf: Path, entry: str, classes: dict[str, np.ndarray]):
     return profile_entry(elf, entry, _records(classes), MODES)
 
 
+def _eval(elf: Path, x: np.ndarray, n_out: int) -> np.ndarray:
+    """float32 rows through a stateless build's records harness in the emulator."""
+    out = Harness(elf).run(np.ascontiguousarray(x).view(np.uint8).reshape(x.shape[0], -1))
+    return out.view(np.float32).reshape(x.shape[0], n_out)
+
+
 def _errors(a: art.Artifact, y: np.ndarray, x_inside: np.ndarray) -> tuple[float, float]:
     err = np.abs(y.astype(np.float64) - reference.reference_eval64(a, x_inside))
     span = (a.output_map.xmax - a.output_map.xmin).astype(np.float64)
@@ -70,10 +78,10 @@ def _errors(a: art.Artifact, y: np.ndarray, x_inside: np.ndarray) -> tuple[float
 
 def ours(a: art.Artifact, opt: str, classes: dict[str, np.ndarray]) -> Row:
     """Our generated network path at one optimisation level (bit-exactness checked on the way)."""
-    build = arm.network_build(a, opt=opt)
+    build = arm_build(NetworkUnit(a), opt=opt)
     prof = _profile(build.elf, "network_eval", classes)
     x_in = classes["inside"]
-    y = arm.eval_network_arm(build.elf, x_in)
+    y = _eval(build.elf, x_in, a.n_out)
     g = golden.network_eval(a, x_in)
     exact = bool(np.array_equal(y.view(np.uint32), g.view(np.uint32)))
     flash = size.sizes(build.elf, build.map).of_objects(["network.o", "sg_math.o"])["flash"]
@@ -109,12 +117,13 @@ def emlearn_row(a: art.Artifact, classes: dict[str, np.ndarray]) -> Row:
     import emlearn
 
     P = EML_NAME.upper()
-    adapter = arm.render_adapter("network", entry=EML_NAME, header=f"{EML_NAME}.h",
-                                 n_in_macro=f"{P}_N_IN", n_out_macro=f"{P}_N_OUT")
+    adapter = arm.render_adapter("records", entry=EML_NAME, header=f"{EML_NAME}.h", step=f"{EML_NAME}_eval", init="",
+                                 layout_checks=[f"{P}_N_IN == {a.n_in}", f"{P}_N_OUT == {a.n_out}"],
+                                 input_words=a.n_in, output_words=a.n_out, state_words=0)
     build = arm.build(emlearn_sources(a), adapter, opt="-O2", peer=True)
     xn_classes = {c: golden.normalise(a, x) for c, x in classes.items()}
     prof = _profile(build.elf, f"{EML_NAME}_eval", xn_classes)
-    yn = arm.eval_network_arm(build.elf, xn_classes["inside"])
+    yn = _eval(build.elf, xn_classes["inside"], a.n_out)
     om = a.output_map
     y = (yn.astype(np.float64) - float(om.ymin)) / om.gain.astype(np.float64) + om.xoffset.astype(np.float64)
     err, rel = _errors(a, y, classes["inside"])

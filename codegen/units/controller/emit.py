@@ -1,5 +1,5 @@
 """C emitter of the whole flight controller (paper 001 Fig. 2): `<name>.h`, `<name>.c`, plus the
-network path `<name>_nn.{h,c}` from codegen.emit's own templates (the MLP code is not forked) and
+network path `<name>_nn.{h,c}` from the network unit's own templates (the MLP code is not forked) and
 the deterministic math library.
 
 Record layouts for the harnesses (numpy structured dtypes matching the C structs: all fields are

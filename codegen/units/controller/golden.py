@@ -5,7 +5,7 @@ integer operations in the C's order, vectorised across a batch of independent st
 INPUT_DTYPE, shape (N,)), returns the OUTPUT_DTYPE array and the new state; calling it again with
 that state continues N sequences. A vec3 is a tuple of three float32 arrays; sums follow the C's
 parentheses; transcendental functions are codegen.detmath (never np.sin/np.tanh); the network is
-codegen.golden.network_eval, computed for every row and selected where the network flies (the
+codegen.units.network.golden.network_eval, computed for every row and selected where the network flies (the
 C calls it only there; the rows it computes are the same).
 """
 from __future__ import annotations

@@ -5,7 +5,7 @@ values come from the same formulas as host.tanh_law.compile_constants and are ro
 float32 once, here, for both the C and the golden twin (codegen.golden_tanh reads
 `constants32`). Output is a pure function of (parameters, period, name, generator version):
 byte-identical sources for the same inputs. The deterministic math library is copied next to
-the law (codegen.emit.math_sources).
+the law (codegen.cgen.math_sources).
 """
 from __future__ import annotations
 
