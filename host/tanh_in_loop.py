@@ -136,29 +136,6 @@ def run_in_loop(target: str, period: float = DEFAULT_PERIOD, duration: float = 4
 def _plot_c_vs_float64(path: Path, t: np.ndarray, diff: np.ndarray, self_diff: np.ndarray, metrics: dict) -> None:
     """|‖e‖_C − ‖e‖_float64| over the run, beside the float64 run's own change from a float32-rounded
     w_c(0), on a log scale with the 1e-6 line of issue 7."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    ax.semilogy(t, np.maximum(diff, 1e-16), label=f"C ({metrics['target']}) vs float64 sampled run")
-    ax.semilogy(t, np.maximum(self_diff, 1e-16), label="float64 run from w_c(0) rounded to float32 vs float64", alpha=0.8)
-    ax.axhline(1e-6, color="k", lw=0.8, ls="--", label="1e-6")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("|Δ‖e‖| (-)")
-    ax.set_title(f"tanh law, sampled T = {metrics['period']} s: the C against the float64 run")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(loc="lower left", fontsize=8)
-    fig.tight_layout()
-    with atomic.writing(path, suffix=".png") as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
-
-
-def _plot_c_vs_float64(path: Path, t: np.ndarray, diff: np.ndarray, self_diff: np.ndarray, metrics: dict) -> None:
-    """|‖e‖_C − ‖e‖_float64| over the run, beside the float64 run's own change from a float32-rounded
-    w_c(0), on a log scale with the 1e-6 line of issue 7."""
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.semilogy(t, np.maximum(diff, 1e-16), label=f"C ({metrics['target']}) vs float64 sampled run")
     ax.semilogy(t, np.maximum(self_diff, 1e-16), label="float64 run from w_c(0) rounded to float32 vs float64", alpha=0.8)

@@ -3,7 +3,6 @@ coverage of every branch, other parameters and periods, the golden twin against 
 law, the generated text (SPEC section 5) and parameter-file errors through the CLI. (What every
 unit must do — gate on every class, a one-ulp change caught, SPEC 6 golden, determinism — is in
 tests/codegen/units/test_every_unit.py.)"""
-import ast
 import json
 import math
 import re
@@ -14,7 +13,6 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import host.cli as cli
-from codegen.unit import Batch
 from codegen.units.tanh import emit as tanh_emit
 from codegen.units.tanh import golden as gt
 from codegen.units.tanh.emit import INPUT_DTYPE, STATE_DTYPE
