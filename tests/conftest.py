@@ -1,7 +1,7 @@
 """Fixtures shared by the closed-loop tests of the generated controller."""
 import pytest
 
-from host.nn_controller import load_artifact
+from host.control.nn_controller import load_artifact
 
 
 @pytest.fixture

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from host.cli.args import parse_int, parse_number
 from host.cli.simulate import check_output_folder, controller_options
-from host.controllers import CONTROLLERS
+from host.control.controllers import CONTROLLERS
 from host.errors import HostError
 from codegen import atomic
 
@@ -29,7 +29,7 @@ def register(subparsers) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    from host import impulse
+    from host.sim import impulse
 
     if args.controller not in CONTROLLERS:
         raise HostError(f"unknown controller {args.controller!r} (known: {', '.join(sorted(CONTROLLERS))})")

@@ -16,14 +16,14 @@ from pathlib import Path
 
 import numpy as np
 
-from host.campaign import format_table, run_campaign, write_campaign
-from host.constants import DEG
-from host.earth import elevation
+from host.sim.campaign import format_table, run_campaign, write_campaign
+from host.core.constants import DEG
+from host.plant.earth import elevation
 from host.errors import HostError
-from host.metrics import DEFAULT_PLAN
-from host.orbit import TABLE5_ELEMENTS, TABLE5_EPOCH_UTC
-from host.simulator import SimConfig, environment_track
-from host.targets import central_target
+from host.sim.metrics import DEFAULT_PLAN
+from host.plant.orbit import TABLE5_ELEMENTS, TABLE5_EPOCH_UTC
+from host.sim.simulator import SimConfig, environment_track
+from host.sim.targets import central_target
 from codegen import atomic
 from codegen.cgen import write_sources
 from codegen.units.network.unit import NetworkUnit
@@ -83,8 +83,8 @@ PRESET_SAMPLES = 2_000
 
 def stage_samples(ctx: PipelineContext) -> None:
     """Optimal-control samples (CasADi/IPOPT) on a Dask LocalCluster, sharded as `staregen samples`."""
-    from host.ocp import OcpConfig
-    from host.samples import DatasetPlan, create_dataset, load_dataset
+    from host.learn.ocp import OcpConfig
+    from host.learn.samples import DatasetPlan, create_dataset, load_dataset
 
     plan = DatasetPlan(n_samples=PRESET_SAMPLES, ocp=OcpConfig(), master_seed=PRESET_SEED).validate()
     run = create_dataset(ctx.out / "samples", plan, progress=True)
@@ -97,7 +97,7 @@ def stage_samples(ctx: PipelineContext) -> None:
 
 def stage_train(ctx: PipelineContext) -> None:
     """The 12-40-3 tansig network trained on the samples; its artifact feeds codegen."""
-    from host import training
+    from host.learn import training
 
     a, report = training.train_artifact(ctx.out / "samples", recipe="default", seed=PRESET_SEED)
     training.save_artifact(a, ctx.out / "network.json")

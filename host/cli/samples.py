@@ -1,6 +1,6 @@
 """`staregen samples`: optimal-control samples (paper 001 section 5) on Dask, sharded and resumable.
 
-Draws N sample inputs S_in in the Table 2 box from --seed, solves one OCP per sample (host.ocp)
+Draws N sample inputs S_in in the Table 2 box from --seed, solves one OCP per sample (host.learn.ocp)
 on a local Dask cluster or an existing scheduler, and writes shards into --out (docs/ocp.md).
 Rerunning the same command resumes: finished shards are validated and kept, the rest computed.
 """
@@ -8,8 +8,8 @@ from __future__ import annotations
 
 
 from host.cli.args import parse_int, parse_number
-from host.ocp import OBJECTIVES, OcpConfig
-from host.samples import DEFAULT_SHARD_SIZE, DatasetPlan, create_dataset, load_dataset, timing_summary
+from host.learn.ocp import OBJECTIVES, OcpConfig
+from host.learn.samples import DEFAULT_SHARD_SIZE, DatasetPlan, create_dataset, load_dataset, timing_summary
 
 
 def register(subparsers) -> None:

@@ -10,14 +10,14 @@ import argparse
 from pathlib import Path
 
 from codegen import artifact as art
-from host import tanh_example, tanh_in_loop
+from host.sim import tanh_example, tanh_in_loop
 from host.cli.args import parse_int, parse_number
-from host.campaign import format_table, run_campaign, validate_campaign, write_campaign
-from host.controllers import ARTIFACT_CONTROLLERS, CONTROLLERS
+from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
+from host.control.controllers import ARTIFACT_CONTROLLERS, CONTROLLERS
 from host.errors import HostError
-from host.metrics import ImagingPlan
-from host.simulator import SimConfig
-from host.targets import parse_target
+from host.sim.metrics import ImagingPlan
+from host.sim.simulator import SimConfig
+from host.sim.targets import parse_target
 from codegen import atomic
 
 DEFAULT_DURATION_S = 100.0

@@ -8,8 +8,8 @@ sweep.json, sweep.md and the best tansig net as model.json into --out.
 from __future__ import annotations
 
 
-from host import sweep as sweep_mod
-from host import training
+from host.learn import sweep as sweep_mod
+from host.learn import training
 from host.cli.args import parse_int, parse_number
 
 

@@ -1,6 +1,6 @@
 """Command-line options shared by every command that works on a generated unit (codegen, verify,
 cycles): `--unit` names a registered unit (codegen.units), the input flags bind it, and the host
-adds its flight configuration and realistic inputs (host.scenarios.configure_unit)."""
+adds its flight configuration and realistic inputs (host.sim.scenarios.configure_unit)."""
 from __future__ import annotations
 
 import argparse
@@ -12,8 +12,8 @@ from codegen.unit import Unit
 from codegen.units.tanh.params import load_params
 from host.cli.args import parse_number
 from host.errors import HostError
-from host.nn_controller import load_artifact
-from host.scenarios import configure_unit
+from host.control.nn_controller import load_artifact
+from host.sim.scenarios import configure_unit
 
 
 def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network") -> None:

@@ -13,9 +13,9 @@ from codegen.units.network import golden
 from codegen.units.network.unit import NetworkUnit
 from firmware import x86
 from firmware.errors import FirmwareError
-from host import tanh_example as ex
-from host.nn_controller import load_artifact
-from host.scenarios import configure_unit
+from host.sim import tanh_example as ex
+from host.control.nn_controller import load_artifact
+from host.sim.scenarios import configure_unit
 from tools.runners import X86Runner
 
 CONTROL = 0xFFC0  # MXCSR control bits; bits 0-5 are sticky exception flags that float code sets

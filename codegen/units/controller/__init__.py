@@ -4,7 +4,7 @@ from codegen.unit import UnitKind
 from codegen.units.controller.unit import configure
 
 # The example's configuration (gains, limits, Earth constants) and realistic inputs come from the
-# host (host.scenarios.unit_inputs), like every binding of this unit.
+# host (host.sim.scenarios.unit_inputs), like every binding of this unit.
 KIND = UnitKind(name="controller", summary="the whole Fig. 2 controller step (network inside, PID fallback)",
                 needs=("artifact", "config"), configure=configure,
                 example=lambda: {"artifact": random_artifact((12, 40, 3), seed=1)})

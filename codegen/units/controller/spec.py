@@ -1,8 +1,8 @@
 """What the generated flight controller (paper 001 Fig. 2) is, in numbers shared by its three
-implementations: the float64 twin (host/nn_controller.py), the generated C
+implementations: the float64 twin (host/control/nn_controller.py), the generated C
 (codegen/templates/controller.*.j2) and the float32 golden model (codegen/golden_controller.py).
 
-The host fills a ControllerConfig from its own constants (host.nn_controller.flight_config), so
+The host fills a ControllerConfig from its own constants (host.control.nn_controller.flight_config), so
 codegen never imports the simulator. Status word bits and the time base are fixed here.
 """
 from __future__ import annotations
@@ -32,7 +32,7 @@ LAT_BAM_MAX = 1 << 30
 J2000_JDN = 2451545
 UTC_MS_MAX = 86_401_000          # exclusive
 UTC_DAY_MIN, UTC_DAY_MAX = -36_525, 73_050   # accepted 1900 .. 2200; accuracy stated for 2000 .. 2100
-# GMST (IAU-82, the host's host.timebase.gmst) in Q64 turns, all integer:
+# GMST (IAU-82, the host's host.core.timebase.gmst) in Q64 turns, all integer:
 #   q = GMST_A + GMST_B * d + GMST_Q * (2d - 1)^2 + GMST_R * ms   (mod 2^64)
 # from GMST(0h) = 24110.54841 + 8640184.812866 Tu + 0.093104 Tu^2 s, Tu = (d - 0.5) / 36525, plus
 # 1.002737909350795 sidereal s per UT1 s. Dropped: the -6.2e-6 Tu^3 s term (< 1e-4 arcsec) and the

@@ -1,7 +1,7 @@
 """C emitter of paper 000's tanh saturation law: parameters + control period -> `<name>.h/.c`.
 
 The parameters (codegen.tanh_params) are baked in as float32 hex-float constants; the float64
-values come from the same formulas as host.tanh_law.compile_constants and are rounded to
+values come from the same formulas as host.control.tanh_law.compile_constants and are rounded to
 float32 once, here, for both the C and the golden twin (codegen.golden_tanh reads
 `constants32`). Output is a pure function of (parameters, period, name, generator version):
 byte-identical sources for the same inputs. The deterministic math library is copied next to

@@ -1,7 +1,7 @@
 """Parameter file schema of paper 000's tanh saturation law (eq. 10-20) and its one validator.
 
 Lives in codegen because the C generator bakes the parameters in and codegen must not import
-host; host.tanh_law re-exports every name. Errors are one-line `TanhParamsError`s (a
+host; host.control.tanh_law re-exports every name. Errors are one-line `TanhParamsError`s (a
 CodegenError, so the CLI prints them as one line).
 """
 from __future__ import annotations
@@ -161,7 +161,7 @@ def load_params(path: str | Path) -> TanhParams:
 
 
 def derived_constants(p: TanhParams) -> dict[str, object]:
-    """float64 values the law needs beyond the parameters (host.tanh_law.compile_constants
+    """float64 values the law needs beyond the parameters (host.control.tanh_law.compile_constants
     computes the same ones): J⁻¹, ‖J⁻¹‖ (spectral), r1, r2 of f (11), the u_a gains of (20)."""
     J = np.array(p.inertia, dtype=float)
     J_inv = np.linalg.inv(J)

@@ -16,7 +16,7 @@ from codegen import GENERATOR_VERSION
 from codegen.unit import Batch, Unit
 from firmware import arm, symbols
 from firmware.errors import FirmwareError
-from host.scenarios import configure_unit
+from host.sim.scenarios import configure_unit
 from tools.gate import compare_fields, run_gate
 from tools.runners import X86Runner, arm_build, runner
 

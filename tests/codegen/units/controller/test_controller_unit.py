@@ -15,10 +15,10 @@ from codegen.units.controller.emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE
 from codegen.units.controller.unit import ControllerUnit
 from firmware import arm
 from host.cli import main
-from host.constants import ARCSEC, DEG
-from host.nn_controller import flight_config, load_artifact
-from host.scenarios import StaringScenario
-from host.timebase import gmst
+from host.core.constants import ARCSEC, DEG
+from host.control.nn_controller import flight_config, load_artifact
+from host.sim.scenarios import StaringScenario
+from host.core.timebase import gmst
 from tools.gate import compare_fields
 from tools.runners import arm_build, layout_checks, runner
 
@@ -193,7 +193,7 @@ def test_dwell_and_hand_back_in_the_c(unit, scenario):
 
 
 def test_gmst_accurate_across_2000_2100():
-    """The controller's integer GMST vs host.timebase.gmst (float64 IAU-82): < 0.001 arcsec."""
+    """The controller's integer GMST vs host.core.timebase.gmst (float64 IAU-82): < 0.001 arcsec."""
     rng = np.random.default_rng(0)
     day = np.concatenate([[0, 36524], rng.integers(0, 36525, 20000)])
     ms = np.concatenate([[0, 86_399_999], rng.integers(0, 86_400_000, 20000)])

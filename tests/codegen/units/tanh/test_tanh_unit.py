@@ -18,9 +18,9 @@ from codegen.units.tanh import golden as gt
 from codegen.units.tanh.emit import INPUT_DTYPE, STATE_DTYPE
 from codegen.units.tanh.params import TanhParamsError, load_params
 from codegen.units.tanh.unit import TanhUnit
-from host import tanh_example as ex
-from host import tanh_law
-from host.scenarios import Paper000ClosedLoop
+from host.sim import tanh_example as ex
+from host.control import tanh_law
+from host.sim.scenarios import Paper000ClosedLoop
 from tools.gate import compare_fields
 from tools.runners import runner
 

@@ -1,0 +1,78 @@
+"""The generated flight controller flown in the staring simulator: SIL (x86) and PIL (ARM emulator).
+
+Each control period the Measurement is packed into the unit's input record exactly as a flight
+computer would fill it (float32 SI values, UTC as days since 2000-01-01 and milliseconds of day,
+target as binary angles) and stepped by tools.inloop, with the golden model alongside (every
+step compared bit for bit). Registered controllers (host.control.controllers):
+  nn-c    generated controller on x86 (network inside the envelope, PID fallback);
+  pid-c   the same controller generated with ControllerConfig.pid_only (its envelope emitted
+          empty), so every step flies its PID branch: the flight PID code, not a separate entry;
+  nn-arm  generated controller on the emulated Cortex-M4; ControlOutput.info["cycles"] holds the
+          step's cycles (ideal memory).
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from codegen.units.controller import spec as cs
+from codegen.units.controller.emit import INPUT_DTYPE, to_bam
+from codegen.units.controller.unit import ControllerUnit
+from host.control.controllers import ControlOutput, Measurement
+from host.control.nn_controller import flight_config, load_artifact
+from host.core.timebase import normalise_time
+from tools.inloop import InTheLoop
+
+
+def pack_input(m: Measurement) -> np.ndarray:
+    """One input record from a Measurement (float32 rounding happens here, as on board)."""
+    jd, sec = normalise_time(int(m.jd_days), float(m.sec_of_day))
+    rec = np.zeros(1, dtype=INPUT_DTYPE)
+    rec["A_bo"], rec["omega_b"] = m.A_bo, m.omega_b
+    rec["R_s"], rec["V_s"] = m.R_s, m.V_s
+    rec["lon"], rec["lat"] = to_bam(m.lon), to_bam(m.lat)
+    rec["utc_day"] = int(jd) - cs.J2000_JDN
+    rec["utc_ms"] = int(round(float(sec) * 1000.0))
+    return rec
+
+
+def control_output(out: np.ndarray, **extra) -> ControlOutput:
+    status = int(out["status"][0])
+    info = {"A_bd": out["A_bd"][0].astype(float), "omega_e": out["omega_e"][0].astype(float),
+            "status": status, **extra}
+    return ControlOutput(torque=out["torque"][0].astype(float), mode="pid" if status & cs.STATUS_PID else "nn",
+                         info=info)
+
+
+class GeneratedController:
+    """The controller unit in the loop on one target (x86: SIL, arm: PIL with cycles)."""
+
+    def __init__(self, unit: ControllerUnit, target: str, name: str):
+        self.name, self.target = name, target
+        self.loop = InTheLoop(unit, target)
+
+    def reset(self) -> None:
+        self.loop.reset()
+
+    def step(self, m: Measurement) -> ControlOutput:
+        out = self.loop.step(pack_input(m))
+        extra = {"cycles": self.loop.cycles[-1]} if self.target == "arm" else {}
+        return control_output(out, **extra)
+
+
+def _unit(artifact: str | None, torque_limit: float, control_period: float, pid_only: bool = False):
+    cfg = flight_config(torque_limit, control_period)
+    return ControllerUnit(load_artifact(artifact), dataclasses.replace(cfg, pid_only=pid_only))
+
+
+def make_sil_controller(*, torque_limit: float, control_period: float, artifact: str | None = None):
+    return GeneratedController(_unit(artifact, torque_limit, control_period), "x86", "nn-c")
+
+
+def make_sil_pid_controller(*, torque_limit: float, control_period: float, artifact: str | None = None):
+    return GeneratedController(_unit(artifact, torque_limit, control_period, pid_only=True), "x86", "pid-c")
+
+
+def make_pil_controller(*, torque_limit: float, control_period: float, artifact: str | None = None):
+    return GeneratedController(_unit(artifact, torque_limit, control_period), "arm", "nn-arm")
