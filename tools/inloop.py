@@ -29,7 +29,7 @@ class InTheLoop:
             self.run.cycles.clear()
         self.inputs: list[np.ndarray] = []
         self.outputs: list[np.ndarray] = []
-        self.states: list[np.ndarray] = []     # the golden twin's state before each step
+        self.states: list[np.ndarray] = []     # the golden state before each step (twin or golden target)
         self.mismatch_steps = 0
 
     @property
@@ -41,7 +41,7 @@ class InTheLoop:
         """One step: inp is one input record (shape (1,)); returns the output record (shape (1,))."""
         inp = np.ascontiguousarray(inp, dtype=self.unit.input_dtype).reshape(1)
         reference = self.twin if self.twin is not None else self.run
-        if self.unit.stateful:
+        if self.unit.stateful and isinstance(reference, GoldenRunner):
             self.states.append(reference.state.copy())
         out = self.run.sequence(inp)
         if self.twin is not None:

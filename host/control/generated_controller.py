@@ -2,8 +2,9 @@
 
 Each control period the Measurement is packed into the unit's input record exactly as a flight
 computer would fill it (float32 SI values, UTC as days since 2000-01-01 and milliseconds of day,
-target as binary angles) and stepped by tools.inloop, with the golden model alongside (every
-step compared bit for bit). Registered controllers (host.control.controllers):
+target as binary angles) and stepped by tools.inloop. The golden twin is off by default (it would
+double the cost of a campaign); the tests replay `loop.trace()` through the golden model, and
+`golden_twin=True` compares every step as it happens. Registered controllers (host.control.controllers):
   nn-c    generated controller on x86 (network inside the envelope, PID fallback);
   pid-c   the same controller generated with ControllerConfig.pid_only (its envelope emitted
           empty), so every step flies its PID branch: the flight PID code, not a separate entry;
@@ -48,9 +49,9 @@ def control_output(out: np.ndarray, **extra) -> ControlOutput:
 class GeneratedController:
     """The controller unit in the loop on one target (x86: SIL, arm: PIL with cycles)."""
 
-    def __init__(self, unit: ControllerUnit, target: str, name: str):
+    def __init__(self, unit: ControllerUnit, target: str, name: str, golden_twin: bool = False):
         self.name, self.target = name, target
-        self.loop = InTheLoop(unit, target)
+        self.loop = InTheLoop(unit, target, golden_twin=golden_twin)
 
     def reset(self) -> None:
         self.loop.reset()
