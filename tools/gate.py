@@ -81,7 +81,7 @@ def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 
     invariants = unit.check_outputs(np.concatenate(list(outs.values())))
     if g_seq is not None:
         invariants += unit.check_outputs(g_seq.reshape(-1))
-    _verdict(result, "golden", invariants, log, "invariants hold")
+    _log_problems(result, "golden", invariants, log, "invariants hold")
     for target in targets:
         t0 = time.perf_counter()
         run = runner(unit, target)
@@ -95,7 +95,7 @@ def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 
             run.reset()
             problems += compare_fields(g_seq[s], run.sequence(seqs[s]), f"sequence {s}: ")
         result.seconds[target] = round(time.perf_counter() - t0, 2)
-        _verdict(result, f"{target} vs golden ({result.seconds[target]:.2f} s)", problems, log, "identical")
+        _log_problems(result, f"{target} vs golden ({result.seconds[target]:.2f} s)", problems, log, "identical")
     for line in unit.extra_report(classes, outs):
         log(line)
     result.seconds["total"] = round(time.perf_counter() - start, 2)
@@ -103,7 +103,7 @@ def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 
     return result
 
 
-def _verdict(result: GateResult, what: str, problems: list[str], log, good: str) -> None:
+def _log_problems(result: GateResult, what: str, problems: list[str], log, good: str) -> None:
     log(f"{what}: " + (good if not problems else "MISMATCH"))
     for p in problems[:MAX_LINES]:
         log("  " + p)

@@ -21,7 +21,7 @@ def register(subparsers) -> None:
     gate.add_argument("--params", required=True, metavar="FILE", help="parameter file (.toml or .json)")
     gate.add_argument("--period", default=None, metavar="S", help="control period, s (default 0.1)")
     verify.add_gate_arguments(gate)
-    gate.set_defaults(func=run_gate, name=None)
+    gate.set_defaults(func=run_old_gate, name=None)
 
 
 def _as_unit(args: argparse.Namespace) -> argparse.Namespace:
@@ -34,6 +34,6 @@ def run_codegen(args: argparse.Namespace) -> int:
     return codegen.run(_as_unit(args))
 
 
-def run_gate(args: argparse.Namespace) -> int:
+def run_old_gate(args: argparse.Namespace) -> int:
     deprecated("tanh gate", "verify --unit tanh")
     return verify.run_unit_gate(_as_unit(args))
