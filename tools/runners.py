@@ -23,7 +23,7 @@ from tools.m4.harness import Harness
 from tools.m4.profile import Profiler
 
 TARGETS = ("golden", "x86", "arm")
-LAYOUT_FILE = "sg_unit_layout.c"
+LAYOUT_FILE = "_unit_layout.c"   # sorts first: a drifted dtype fails the build before any other compile
 
 
 # ----------------------------------------------------------------------------- record layout
