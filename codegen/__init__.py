@@ -1,3 +1,4 @@
-"""Model artifact, deterministic float32 math, C emitter and the golden model that mirrors it."""
+"""Model artifact, deterministic float32 math, the generated-unit interface (unit.py) and one folder per
+unit in units/ (emitter, templates, golden model, gate vectors)."""
 
 GENERATOR_VERSION = "0.1.0"

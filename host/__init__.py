@@ -1,1 +1,2 @@
-"""Ground-side float64 models: scenario, dynamics, guidance, simulator, controllers, CLI."""
+"""Ground side, float64, by concern: core conventions, plant, guidance (gnc), control laws, simulation (sim),
+learning (learn) and the staregen CLI."""
