@@ -48,6 +48,26 @@ class Budgets:
 
 
 @dataclass(frozen=True)
+class FieldDoc:
+    """One record field as the interface control document states it (the package's ICD.md)."""
+
+    name: str          # the C struct member (the dtype field)
+    unit: str          # physical unit, e.g. "rad/s", "N*m", "-" for dimensionless, "bits" for a status word
+    frame: str         # frame of the components, e.g. "S_b", "ECI", "-" when not a vector
+    range: str         # accepted / produced range and what happens outside it
+    meaning: str       # one sentence
+
+
+@dataclass(frozen=True)
+class StatusBit:
+    """One bit (or field) of a unit's status word, for the ICD."""
+
+    name: str          # the C macro, without the entry prefix, e.g. "STATUS_PID"
+    mask: int
+    meaning: str
+
+
+@dataclass(frozen=True)
 class Stage:
     """A stateless sub-function of a unit, exposed for stage-by-stage tests (e.g. normalise)."""
 
@@ -83,6 +103,12 @@ def words(a: np.ndarray) -> np.ndarray:
     """A record array as its raw 32-bit words, (N, itemsize / 4) uint32 (bit-exact comparisons)."""
     a = np.ascontiguousarray(a)
     return a.view(np.uint32).reshape(a.shape[0], -1)
+
+
+def float_words(dtype: np.dtype) -> np.ndarray:
+    """Per 32-bit word of a record: True where it is a float32 (bit comparisons let NaN match NaN there)."""
+    return np.concatenate([np.full(dtype.fields[name][0].itemsize // 4, dtype.fields[name][0].base == np.float32)
+                           for name in dtype.names])
 
 
 class Unit(ABC):
@@ -193,6 +219,17 @@ class Unit(ABC):
     def extra_cycle_facts(self, profile_functions: dict, by_class: dict) -> dict:
         """Unit-specific figures for the cycle report (e.g. the controller without its network)."""
         return {}
+
+    # ------------------------------------------------------------------ interface documentation
+    def field_docs(self) -> dict[str, list[FieldDoc]]:
+        """{"input": [...], "output": [...], "state": [...]}: every dtype field with unit, frame and
+        range, for the flight package's ICD (default: nothing documented; the ICD then lists the
+        fields with their types only and says so)."""
+        return {}
+
+    def status_bits(self) -> list[StatusBit]:
+        """The status word's bits, for the ICD (default: none)."""
+        return []
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from codegen import bitcompare
-from codegen.unit import Unit
+from codegen.unit import Unit, float_words
 from tools.runners import runner
 
 MAX_LINES = 10
@@ -46,6 +46,23 @@ def compare_fields(expected: np.ndarray, actual: np.ndarray, what: str = "") -> 
     return problems
 
 
+def count_mismatches(expected: np.ndarray, actual: np.ndarray) -> int:
+    """Mismatching 32-bit words of two record arrays of one dtype (float NaN as a class)."""
+    e, a = words_of(expected), words_of(actual)
+    if e.shape != a.shape:
+        return max(e.size, a.size)
+    floats = float_words(expected.dtype)
+    nan_e = ((e & 0x7F800000) == 0x7F800000) & ((e & 0x007FFFFF) != 0)
+    nan_a = ((a & 0x7F800000) == 0x7F800000) & ((a & 0x007FFFFF) != 0)
+    return int(((e != a) & ~(floats & nan_e & nan_a)).sum())
+
+
+def words_of(records: np.ndarray) -> np.ndarray:
+    """Record array of any shape -> (rows, words) uint32."""
+    r = np.ascontiguousarray(records)
+    return r.view(np.uint32).reshape(r.size, -1) if r.size else np.zeros((0, r.dtype.itemsize // 4), np.uint32)
+
+
 @dataclass
 class GateResult:
     ok: bool
@@ -55,6 +72,7 @@ class GateResult:
     counts: dict[str, int]
     seconds: dict[str, float] = field(default_factory=dict)
     problems: dict[str, list[str]] = field(default_factory=dict)
+    mismatches: dict[str, int] = field(default_factory=dict)    # target -> mismatching words
 
 
 def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 0,
@@ -87,15 +105,20 @@ def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 
     for target in targets:
         t0 = time.perf_counter()
         run = runner(unit, target)
-        problems = []
+        problems, bad = [], 0
         for c, b in classes.items():
             out, state = run.records(b)
             problems += compare_fields(golden[c][0], out, f"{c}: ")
+            bad += count_mismatches(golden[c][0], out)
             if unit.stateful:
                 problems += compare_fields(golden[c][1], state, f"{c}: state.")
+                bad += count_mismatches(golden[c][1], state)
         for s in range(0 if seqs is None else seqs.shape[0]):
             run.reset()
-            problems += compare_fields(g_seq[s], run.sequence(seqs[s]), f"sequence {s}: ")
+            out = run.sequence(seqs[s])
+            problems += compare_fields(g_seq[s], out, f"sequence {s}: ")
+            bad += count_mismatches(g_seq[s], out)
+        result.mismatches[target] = bad
         result.seconds[target] = round(time.perf_counter() - t0, 2)
         _log_problems(result, f"{target} vs golden ({result.seconds[target]:.2f} s)", problems, log, "identical")
     for line in unit.extra_report(classes, outs):

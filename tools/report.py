@@ -11,18 +11,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from codegen.unit import Unit
+from codegen.unit import Batch, Unit
 from tools import size, stack
 from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES, profile_entry
 from tools.m4.elf import Image
 from tools.runners import arm_build, pack
 
 
-def cycle_report(unit: Unit, modes, per_class: int, seed: int) -> dict:
-    """JSON-ready report of the unit's step."""
+def cycle_report(unit: Unit, modes, per_class: int, seed: int, extra: dict[str, Batch] | None = None) -> dict:
+    """JSON-ready report of the unit's step; `extra` adds classes of the caller's (e.g. a reference step)."""
     build = arm_build(unit, "records")
     image = Image(build.elf)
-    classes = unit.cycle_classes(per_class, seed)
+    classes = {**unit.cycle_classes(per_class, seed), **(extra or {})}
     records = {c: pack(unit, b).view(np.uint8).reshape(b.input.shape[0], -1) for c, b in classes.items()}
     prof = profile_entry(image, unit.step_symbol, records, modes)
     sz = size.sizes(build.elf, build.map)

@@ -20,6 +20,7 @@ import functools
 import numpy as np
 
 from codegen import artifact as art
+from codegen.package.config import PackageConfig
 from codegen.units.controller import spec as cs
 from host.core.constants import DEG, MU_EARTH, WGS84_A, WGS84_E2
 from host.control.controllers import ControlOutput, Measurement
@@ -41,6 +42,20 @@ def flight_config(torque_limit: float = TABLE6.torque_limit, control_period: flo
         torque_limit=float(torque_limit), control_period=float(control_period),
         dwell_steps=int(dwell_steps), integral_limit=INTEGRAL_LIMIT,
         earth_a=WGS84_A, earth_e2=WGS84_E2, earth_rate=float(gmst_rate(cs.J2000_JDN, 0.0)), mu=MU_EARTH)
+
+
+DEFAULT_PACKAGE_NAME = "stare"
+CONFIG_SOURCES = {
+    "pid": "paper 001 Table 1 (host.control.pid.TABLE1_GAINS); integral limit: host.control.nn_controller",
+    "limits": "paper 001 Table 6 (host.plant.spacecraft.TABLE6)",
+    "timing": "paper 001: 0.1 s control period; dwell: host.control.nn_controller.DWELL_STEPS",
+    "earth": "WGS-84 (host.core.constants); rate: d GMST/dt of IAU-82 (host.core.timebase.gmst_rate)",
+}
+
+
+def default_package_config(name: str = DEFAULT_PACKAGE_NAME) -> PackageConfig:
+    """The flight package's default configuration: Table 1 gains, Table 6 limit, the controller unit."""
+    return PackageConfig(name, ("controller",), flight_config())
 
 
 def network64(a: art.Artifact, x: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from codegen import units
+from codegen.package.config import PackageConfig
 from codegen.unit import Batch, Unit
 from codegen.units.controller import spec as cs
 from codegen.units.controller.emit import INPUT_DTYPE, to_bam
@@ -24,6 +25,7 @@ from codegen.units.tanh.emit import STATE_DTYPE as TANH_STATE_DTYPE
 from codegen.units.tanh.vectors import axis_angle_rotations, input_rows, random_rotations
 from host.core.constants import DEG
 from host.core.frames import L_oi
+from host.errors import HostError
 from host.gnc.guidance import desired_state
 from host.control.nn_controller import flight_config
 from host.plant.orbit import TABLE5_EPOCH, propagate_rk4, table5_initial_state
@@ -135,6 +137,20 @@ class Paper000ClosedLoop:
     def cycle_classes(self, unit) -> dict[str, Batch]:
         """`example`: the (state, input) records of the paper-000 example flown by the golden step."""
         return {"example": example_records(unit.params, unit.period)}
+
+
+def package_units(cfg: PackageConfig, artifact, tanh_params=None) -> dict[str, Unit]:
+    """The units of a flight package bound to its configuration: the controller `<name>` flying
+    the network, and the tanh law `<name>_tanh` at the same control period when configured."""
+    units = {"controller": configure_unit("controller", artifact=artifact, config=cfg.controller, name=cfg.name)}
+    if cfg.has_tanh:
+        if tanh_params is None:
+            raise HostError("the configuration's units include \"tanh\": give its parameter file with --tanh")
+        units["tanh"] = configure_unit("tanh", params=tanh_params, period=cfg.controller.control_period,
+                                       name=f"{cfg.name}_tanh")
+    elif tanh_params is not None:
+        raise HostError("--tanh given, but the configuration's [package] units do not include \"tanh\"")
+    return units
 
 
 def unit_inputs(kind: str) -> dict:

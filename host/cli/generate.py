@@ -1,0 +1,99 @@
+"""`staregen generate --config controller.toml --network network.json [--tanh params.toml] --out DIR`:
+the flight package (sources, self-test, CMakeLists, ICD, manifest with the evidence).
+
+The configuration and the network (and the tanh parameters when the configuration includes the
+tanh law) are validated before anything is generated; the package folder appears only when
+complete, and only when the gate and the self-test on x86 and ARM found no mismatch.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+from pathlib import Path
+
+from codegen import artifact as art
+from codegen.package import config as pc
+from codegen.package.selftest import MAX_VECTORS
+from codegen.units.tanh.emit import params_sha256
+from codegen.units.tanh.params import load_params
+from host.cli.args import parse_int
+from host.cli.simulate import check_output_folder
+from host.errors import HostError
+from host.sim.scenarios import package_units
+from tools.package import EvidencePlan, build_package
+from tools.m4.profile import MODES
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("generate", help="write the flight package (sources, self-test, ICD, manifest)",
+                              description=__doc__.splitlines()[0])
+    p.add_argument("--config", required=True, metavar="FILE", help="controller configuration (staregen config init)")
+    p.add_argument("--network", required=True, metavar="FILE", help="network artifact (e.g. out/pipeline/network.json)")
+    p.add_argument("--tanh", default=None, metavar="FILE", help="tanh-law parameter file (when the configuration "
+                   "includes the tanh unit)")
+    p.add_argument("--out", required=True, metavar="DIR", help="package folder (replaced if it holds a package)")
+    add_evidence_arguments(p)
+    p.set_defaults(func=run)
+
+
+def add_evidence_arguments(p: argparse.ArgumentParser) -> None:
+    d = EvidencePlan()
+    p.add_argument("--vectors", default=str(d.selftest_vectors), metavar="N",
+                   help=f"self-test vectors per unit (default {d.selftest_vectors})")
+    p.add_argument("--gate-vectors", default=str(d.gate_vectors), metavar="N",
+                   help=f"gate vectors per unit measured into the manifest (default {d.gate_vectors})")
+    p.add_argument("--cycles-per-class", default=str(d.cycles_per_class), metavar="N",
+                   help=f"cycle-model vectors per class (default {d.cycles_per_class})")
+    p.add_argument("--seed", default=str(d.seed), help=f"vector seed (default {d.seed})")
+
+
+def evidence_plan(args: argparse.Namespace) -> EvidencePlan:
+    return EvidencePlan(gate_vectors=parse_int(args.gate_vectors, "--gate-vectors", minimum=100, maximum=10_000_000),
+                        selftest_vectors=parse_int(args.vectors, "--vectors", minimum=1, maximum=MAX_VECTORS),
+                        cycles_per_class=parse_int(args.cycles_per_class, "--cycles-per-class", minimum=1,
+                                                   maximum=10_000),
+                        seed=parse_int(args.seed, "--seed", maximum=2**63 - 1))
+
+
+def file_sha256(path: Path) -> str:
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError as exc:
+        raise HostError(f"{path}: cannot read ({exc.strerror or exc})") from None
+
+
+def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,
+             plan: EvidencePlan = EvidencePlan(), log=print):
+    """The package of a validated configuration and network (also the pipeline's last stage)."""
+    check_output_folder(out, marker="manifest.json")
+    units = package_units(cfg, network, tanh)
+    return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log)
+
+
+def summary(result) -> list[str]:
+    ev = result.manifest["evidence"]
+    step = ev["units"]["controller"]["cycles"]["step"]
+    lines = [f"package: {result.folder} ({len(result.manifest['files']) + 1} files, {result.seconds['total']:.1f} s)"]
+    lines += [f"  self-test on {t}: {r['selftest_mismatches']} mismatching words"
+              for t, r in ev["package_build"].items()]
+    lines.append("  whole step worst case (cycle model): " + ", ".join(f"{m} {step[m]['max']}" for m in MODES)
+                 + " cycles (paper budget 3.3 ms = 554,400)")
+    return lines
+
+
+def run(args: argparse.Namespace) -> int:
+    plan = evidence_plan(args)
+    cfg = pc.load(args.config)
+    network = art.load(args.network)
+    tanh = load_params(args.tanh) if args.tanh is not None else None
+    config_path, network_path = Path(args.config), Path(args.network)
+    inputs = {"config": {"file": config_path.name, "sha256": file_sha256(config_path), "values_sha256": cfg.sha256},
+              "network": {"file": network_path.name, "sha256": file_sha256(network_path),
+                          "payload_sha256": network.sha256, "shape": network.shape_text}}
+    if tanh is not None:
+        tanh_path = Path(args.tanh)
+        inputs["tanh"] = {"file": tanh_path.name, "sha256": file_sha256(tanh_path),
+                          "values_sha256": params_sha256(tanh, cfg.controller.control_period)}
+    result = generate(cfg, network, Path(args.out), inputs, tanh, plan)
+    print("\n".join(summary(result)))
+    return 0

@@ -1,0 +1,48 @@
+"""`staregen package check DIR [--run x86,arm]`: a flight package against its manifest.
+
+Every file's sha256 is checked; an edited, missing or extra file is named on one line and the
+exit status is 1. With --run the package is built with its own CMakeLists for each target and
+`<name>_selftest()` runs (x86-64 natively, the STM32F417 image in the Cortex-M4 emulator, whose
+reference step must take the cycles the manifest records).
+"""
+from __future__ import annotations
+
+import argparse
+
+from host.errors import HostError
+from tools.package import TARGETS, check_package
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("package", help="check a flight package against its manifest",
+                              description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="package_command", required=True, metavar="ACTION")
+    check = sub.add_parser("check", help="verify every file's sha256; optionally re-run the self-test")
+    check.add_argument("folder", metavar="DIR")
+    check.add_argument("--run", default="", metavar="TARGETS",
+                       help="comma-separated targets to build and run the self-test on: x86, arm")
+    check.set_defaults(func=run_check)
+
+
+def parse_targets(text: str) -> tuple[str, ...]:
+    targets = tuple(t.strip() for t in text.split(",") if t.strip())
+    for t in targets:
+        if t not in TARGETS:
+            raise HostError(f"--run: unknown target {t!r} (choose from {', '.join(TARGETS)})")
+    return tuple(dict.fromkeys(targets))
+
+
+def run_check(args: argparse.Namespace) -> int:
+    targets = parse_targets(args.run)
+    doc, problems, runs = check_package(args.folder, targets)
+    for line in problems:
+        print(f"{args.folder}: {line}")
+    if problems:
+        return 1
+    print(f"{args.folder}: {len(doc['files'])} files match the manifest (package {doc['name']}, "
+          f"staregen {doc['generator']['version']})")
+    for t, r in runs.items():
+        cyc = r.get("reference_cycles")
+        extra = f"; reference step {cyc['ideal']} ideal / {cyc['art']} art cycles" if cyc else ""
+        print(f"  {t}: self-test 0 mismatching words{extra}")
+    return 0
