@@ -22,6 +22,27 @@
 #ifndef SG_MATH_H
 #define SG_MATH_H
 
+/* Build guard: refuse the compiler settings that silently change results (SPEC section 5).
+ * Detected here: -ffast-math / -Ofast (__FAST_MATH__), -ffinite-math-only, excess precision
+ * (FLT_EVAL_METHOD != 0, e.g. x87), and GNU C mode (-std=gnu*), whose default is
+ * -ffp-contract=fast, unless the build states -ffp-contract=off by defining SG_FP_CONTRACT_OFF.
+ * Not detectable by the preprocessor: -ffp-contract=fast given explicitly in ISO mode,
+ * -fassociative-math / -funsafe-math-optimizations / -freciprocal-math without -ffast-math, and
+ * flush-to-zero or a directed rounding mode set at run time. The package self-test
+ * (<name>_selftest) catches those on the target. */
+#if defined(__FAST_MATH__)
+#error "sg_math: built with -ffast-math (or -Ofast): results would differ from the golden model; remove it"
+#endif
+#if defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__
+#error "sg_math: built with -ffinite-math-only: NaN and infinity handling is required; remove it"
+#endif
+#if defined(__FLT_EVAL_METHOD__) && (__FLT_EVAL_METHOD__ != 0) && (__FLT_EVAL_METHOD__ != -1)
+#error "sg_math: float expressions evaluated in excess precision (FLT_EVAL_METHOD != 0); use SSE / the FPU's single precision"
+#endif
+#if defined(__GNUC__) && !defined(__STRICT_ANSI__) && !defined(SG_FP_CONTRACT_OFF)
+#error "sg_math: GNU C mode contracts a*b+c into fused multiply-adds by default; build with -std=c99, or add -ffp-contract=off -DSG_FP_CONTRACT_OFF"
+#endif
+
 #include <stdint.h>
 
 /* tanh(x) (MATLAB tansig(n) = 2/(1+exp(-2n)) - 1); odd, |result| <= 1, exactly +-1 for

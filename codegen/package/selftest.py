@@ -44,12 +44,15 @@ class SelftestVectors:
 
 
 def make_vectors(unit: Unit, n: int = DEFAULT_VECTORS, seed: int = 0) -> SelftestVectors:
-    """n vectors from the unit's gate classes (deterministic in seed) with their golden results."""
+    """n vectors from the unit's gate classes (deterministic in seed) with their golden results;
+    vector 0 starts from the init state (the timing reference)."""
     if not 1 <= n <= MAX_VECTORS:
         raise CodegenError(f"self-test vectors must be in [1, {MAX_VECTORS}], got {n}")
     classes = {c: b for c, b in unit.gate_classes(n, seed).items() if b.input.shape[0] > 0}
     inputs = np.concatenate([b.input for b in classes.values()])
     state = np.concatenate([b.state for b in classes.values()]) if unit.stateful else None
+    if state is not None:
+        state[0] = unit.init_state(1)[0]   # the reference: the first step after init on a first-class input
     out, after = unit.golden(None if state is None else state.copy(), inputs)
     return SelftestVectors(unit, state, inputs, out, after, {c: int(b.input.shape[0]) for c, b in classes.items()})
 

@@ -3,8 +3,9 @@
 Stages: scenario summary; the central-target PID simulation (<out>/pid_central/); optimal-control
 samples on Dask (<out>/samples/, the `regularised` objective); training of the 12-40-3 tansig
 network on them (<out>/network.json, <out>/training.md); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
-ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); a
-report (report.json, report.txt). The output folder is built atomically: a failed stage leaves
+ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); the
+flight package of the whole Fig. 2 controller with the default configuration (<out>/package,
+<out>/controller.toml); a report (report.json, report.txt). The output folder is built atomically: a failed stage leaves
 no partial folder.
 """
 from __future__ import annotations
@@ -27,7 +28,11 @@ from host.sim.targets import central_target
 from codegen import atomic
 from codegen.cgen import write_sources
 from codegen.units.network.unit import NetworkUnit
+from host.cli.generate import file_sha256, generate, summary
 from host.cli.simulate import check_output_folder
+from host.control.nn_controller import CONFIG_SOURCES, default_package_config
+from codegen.package import config as pc
+from tools.package import EvidencePlan
 from host.cli.verify import TARGETS
 from tools.gate import run_gate
 from tools.m4.profile import MODES
@@ -40,6 +45,7 @@ PRESET_SEED = 0
 @dataclass
 class PipelineContext:
     out: Path                                     # the temporary folder being built
+    final: Path = Path()                          # where it lands
     results: dict = field(default_factory=dict)   # stage name -> summary (goes into report.json)
     artifact: object = None                       # the network artifact (codegen.artifact.Artifact)
     unit: object = None                           # the network unit generated from it
@@ -142,13 +148,36 @@ def stage_cycles(ctx: PipelineContext) -> None:
                       + " (paper: 3.3 ms = 554,400 cycles)")
 
 
+def stage_package(ctx: PipelineContext) -> None:
+    """The flight package of the trained network with the default configuration (<out>/package,
+    its configuration in <out>/controller.toml): sources, self-test, CMakeLists, ICD, manifest."""
+    cfg = default_package_config()
+    config_file = pc.write(cfg, ctx.out / "controller.toml", CONFIG_SOURCES)
+    network_file = ctx.out / "network.json"
+    inputs = {"config": {"file": "controller.toml", "sha256": file_sha256(config_file), "values_sha256": cfg.sha256},
+              "network": {"file": "network.json", "sha256": file_sha256(network_file),
+                          "payload_sha256": ctx.artifact.sha256, "shape": ctx.artifact.shape_text}}
+    result = generate(cfg, ctx.artifact, ctx.out / "package", inputs, plan=PACKAGE_PLAN)
+    ev = result.manifest["evidence"]
+    step = ev["units"]["controller"]["cycles"]["step"]
+    ctx.results["package"] = {"folder": "package", "name": cfg.name, "files": len(result.manifest["files"]) + 1,
+                              "selftest_mismatches": {t: r["selftest_mismatches"] for t, r in ev["package_build"].items()},
+                              "step_max_cycles": {m: step[m]["max"] for m in MODES}, "seconds": result.seconds}
+    lines = summary(result)
+    lines[0] = lines[0].replace(str(ctx.out), str(ctx.final))
+    ctx.report.append("\n".join(lines))
+
+
 def stage_report(ctx: PipelineContext) -> None:
     atomic.write_json(ctx.out / "report.json", ctx.results)
     atomic.write_text(ctx.out / "report.txt", "\n\n".join(ctx.report) + "\n")
 
 
 STAGES = [stage_scenario, stage_pid_central, stage_samples, stage_train, stage_codegen, stage_gate, stage_cycles,
-          stage_report]
+          stage_package, stage_report]
+# The package's evidence at pipeline scale (the standalone `staregen generate` defaults measure more).
+PACKAGE_PLAN = EvidencePlan(gate_vectors=20_000, gate_sequences=4, sequence_steps=200, selftest_vectors=256,
+                            cycles_per_class=20, seed=PRESET_SEED)
 
 
 def register(subparsers) -> None:
@@ -164,7 +193,7 @@ def main(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     try:
         with atomic.directory(out) as tmp:
-            ctx = PipelineContext(out=tmp)
+            ctx = PipelineContext(out=tmp, final=out)
             for stage in STAGES:
                 t0 = time.perf_counter()
                 stage(ctx)
