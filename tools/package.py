@@ -24,10 +24,7 @@ from pathlib import Path
 from codegen import GENERATOR_VERSION, atomic
 from codegen.package import manifest
 from codegen.package.cmake import cmake_lists
-try:
-    from codegen.package.icd import render_icd
-except ImportError:  # TEMP
-    render_icd = None
+from codegen.package.icd import render_icd
 from codegen.package.selftest import SelftestVectors, make_vectors, selftest_sources
 from codegen.unit import Batch, Unit
 from firmware import arm, x86
@@ -201,7 +198,7 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
             if failures:
                 raise ToolError("refusing to write the package: " + "; ".join(failures))
             info = build_info()
-            files["ICD.md"] = render_icd(name, units, config, evidence, {
+            files["ICD.md"] = render_icd(name, units, {**config, "inputs": inputs}, evidence, {
                 "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"]})
             atomic.write_text(tmp / "ICD.md", files["ICD.md"])
             body = {"generator": {"name": "staregen", "version": GENERATOR_VERSION}, "name": name,

@@ -10,6 +10,7 @@ import numpy as np
 
 from codegen.artifact import Artifact
 from codegen.errors import CodegenError
+from codegen.units.controller import interface
 from codegen.unit import Batch, Budgets, Unit
 from codegen.units.controller import golden, vectors
 from codegen.units.controller import spec as cs
@@ -37,6 +38,12 @@ class ControllerUnit(Unit):
 
     def sources(self) -> dict[str, str]:
         return dict(self._sources)
+
+    def field_docs(self):
+        return interface.field_docs(self.config)
+
+    def status_bits(self):
+        return interface.status_bits()
 
     def golden(self, state, inp):
         return golden.step(self.artifact, self.config, state, inp)

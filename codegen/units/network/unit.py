@@ -10,6 +10,7 @@ import numpy as np
 
 from codegen.artifact import Artifact
 from codegen.errors import CodegenError
+from codegen.units.network import interface
 from codegen.unit import Batch, Budgets, Stage, Unit
 from codegen.units.network import golden, reference, vectors
 from codegen.units.network.emit import DEFAULT_NAME, network_sources
@@ -35,6 +36,9 @@ class NetworkUnit(Unit):
 
     def sources(self) -> dict[str, str]:
         return dict(self._sources)
+
+    def field_docs(self):
+        return interface.field_docs(self.artifact)
 
     @property
     def step_symbol(self) -> str:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from codegen.errors import CodegenError
+from codegen.units.tanh import interface
 from codegen.unit import Batch, Budgets, Unit
 from codegen.units.tanh import golden, vectors
 from codegen.units.tanh.emit import (DEFAULT_NAME, DEFAULT_PERIOD, INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE,
@@ -34,6 +35,12 @@ class TanhUnit(Unit):
 
     def sources(self) -> dict[str, str]:
         return dict(self._sources)
+
+    def field_docs(self):
+        return interface.field_docs(self.params)
+
+    def status_bits(self):
+        return interface.status_bits()
 
     def golden(self, state, inp):
         return golden.step(self.constants, state, inp)

@@ -83,13 +83,10 @@ def test_selftest_passes_and_counts_planted_faults(tmp_path, package_sources):
     files, vectors = package_sources
     (tmp_path / "ok").mkdir()
     assert run(build(tmp_path / "ok", files)) == (0, 0)
-    # flip the last bit of one hidden-layer weight literal of the network
+    # flip the top mantissa bit (bit 22) of the first hidden-layer weight W1[0][0]
     nn = files["stare_nn.c"]
-    m = re.search(r"(-?0x1\.[0-9a-f]+p[+-]\d+f)", nn[nn.index("W1"):])
-    lit = m.group(1)
-    mant = lit.split(".")[1].split("p")[0]
-    flipped = lit.replace("." + mant, "." + mant[:-1] + format(int(mant[-1], 16) ^ 1, "x"), 1)
-    bad = dict(files, **{"stare_nn.c": nn.replace(lit, flipped, 1)})
+    m = re.compile(r"0x1\.([0-9a-f])").search(nn, nn.index("/* W1 */"))
+    bad = dict(files, **{"stare_nn.c": nn[:m.start(1)] + format(int(m.group(1), 16) ^ 8, "x") + nn[m.end(1):]})
     (tmp_path / "bad").mkdir()
     mismatches, env = run(build(tmp_path / "bad", bad))
     assert env == 0 and mismatches > 0
