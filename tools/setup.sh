@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Idempotent set-up for a fresh Debian machine: the ARM toolchain from Debian, then the
+# Idempotent set-up for a fresh Debian machine: the ARM toolchain and cmake from Debian, then the
 # Python package (torch pinned to the CPU wheel first so nothing pulls CUDA builds).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,6 +12,13 @@ if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 \
   echo "setup: installing gcc-arm-none-eabi and libnewlib-arm-none-eabi (apt)"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq gcc-arm-none-eabi libnewlib-arm-none-eabi >/dev/null
+fi
+
+# cmake builds the flight package with its own CMakeLists (staregen generate, package check, tests).
+if ! command -v cmake >/dev/null 2>&1; then
+  echo "setup: installing cmake (apt)"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake >/dev/null
 fi
 
 stamp=.setup-stamp
