@@ -213,6 +213,13 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
     return PackageResult(out, doc, seconds)
 
 
+def _dig(doc, *keys) -> dict:
+    """doc[k1][k2]... of a (sealed but otherwise untrusted) manifest; {} where it is not a mapping."""
+    for key in keys:
+        doc = doc.get(key) if isinstance(doc, dict) else None
+    return doc if isinstance(doc, dict) else {}
+
+
 def check_package(folder: str | Path, run: tuple[str, ...] = ()) -> tuple[dict, list[str], dict]:
     """(manifest, problems, runs): the folder against its manifest and, for each target in `run`,
     the self-test built with the package's CMakeLists (with the ARM reference step's cycles compared
@@ -225,7 +232,7 @@ def check_package(folder: str | Path, run: tuple[str, ...] = ()) -> tuple[dict, 
         except (FirmwareError, ToolError) as exc:
             problems.append(f"{target}: the package does not build or run: {exc}")
     if "arm" in runs:
-        want = doc["evidence"]["package_build"].get("arm", {}).get("reference_cycles", {})
+        want = _dig(doc, "evidence", "package_build", "arm", "reference_cycles")
         got = runs["arm"]["reference_cycles"]
         if want and got != want:
             problems.append(f"arm: reference step takes {got} cycles, the manifest says {want}")

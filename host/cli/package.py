@@ -39,8 +39,9 @@ def run_check(args: argparse.Namespace) -> int:
         print(f"{args.folder}: {line}")
     if problems:
         return 1
+    generator = doc.get("generator") if isinstance(doc.get("generator"), dict) else {}
     print(f"{args.folder}: {len(doc['files'])} files match the manifest (package {doc['name']}, "
-          f"staregen {doc['generator']['version']})")
+          f"staregen {str(generator.get('version', '?'))[:20]})")
     for t, r in runs.items():
         cyc = r.get("reference_cycles")
         extra = f"; reference step {cyc['ideal']} ideal / {cyc['art']} art cycles" if cyc else ""
