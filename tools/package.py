@@ -91,10 +91,14 @@ def source_files(name: str, units: dict[str, Unit], vectors: list[SelftestVector
     """Everything but ICD.md and the manifest: sources, self-test, CMakeLists.txt."""
     files = _split_sources(units)
     files.update({f"selftest/{f}": t for f, t in selftest_sources(name, vectors).items()})
-    names = lambda d, ext: sorted(p.split("/", 1)[1] for p in files if p.startswith(d) and p.endswith(ext))
-    files["CMakeLists.txt"] = cmake_lists(name, names("include/", ".h"), names("src/", ".c"),
-                                          names("selftest/", ""), list(COMMON), GENERATOR_VERSION)
+    files["CMakeLists.txt"] = cmake_lists(name, _in(files, "include/"), _in(files, "src/"), _in(files, "selftest/"),
+                                          list(COMMON), GENERATOR_VERSION)
     return files
+
+
+def _in(files: dict[str, str], folder: str) -> list[str]:
+    """File names (without the folder) of the package paths under `folder`."""
+    return sorted(p[len(folder):] for p in files if p.startswith(folder))
 
 
 # ----------------------------------------------------------------------------- evidence
