@@ -84,6 +84,26 @@ def hex_float(value: float) -> str:
     return f"{mantissa}p{exponent}"
 
 
+# Text that the emitters copy into C comments: printable ASCII, bounded, with no sequence that could
+# end the comment ("*/"), open a nested one ("/*"), form a trigraph ("??") or continue a line ("\\"
+# at the end). The generator checks it again when it emits (codegen.cgen.comment).
+COMMENT_TEXT = re.compile(r"[ -~]{0,200}")
+
+
+def comment_text_problem(text) -> str | None:
+    """Why `text` may not go into a C comment, or None if it may."""
+    if not isinstance(text, str):
+        return f"expected a string, got {type(text).__name__}"
+    if not COMMENT_TEXT.fullmatch(text):
+        return "must be printable ASCII of at most 200 characters (it goes into C comments)"
+    for bad in ("*/", "/*", "??"):
+        if bad in text:
+            return f"must not contain {bad!r} (it goes into C comments)"
+    if text.endswith("\\"):
+        return "must not end in a backslash (it goes into C comments)"
+    return None
+
+
 def is_float32_exact(value: float) -> bool:
     """True if the float64 value survives a round trip through float32 (NaN counts as exact)."""
     with np.errstate(over="ignore"):
@@ -435,10 +455,9 @@ def _check_labels(names, units, descriptions, n: int, path: str) -> None:
         if len(seq) != n:
             raise ArtifactError(f"{path}.{key}", f"shape mismatch: expected {n} entries, got {len(seq)}")
         for i, s in enumerate(seq):
-            if not isinstance(s, str):
-                raise ArtifactError(f"{path}.{key}[{i}]", f"expected a string, got {type(s).__name__}")
-            if "*/" in s or "\n" in s:
-                raise ArtifactError(f"{path}.{key}[{i}]", "must not contain '*/' or a newline (it goes into C comments)")
+            problem = comment_text_problem(s)
+            if problem:
+                raise ArtifactError(f"{path}.{key}[{i}]", problem)
     for i, s in enumerate(names):
         if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", s):
             raise ArtifactError(f"{path}.names[{i}]", f"{s!r} is not an identifier")
@@ -446,6 +465,9 @@ def _check_labels(names, units, descriptions, n: int, path: str) -> None:
 
 def _check_envelope(env: Envelope, n_in: int) -> None:
     _check_labels(env.names, env.units, env.descriptions, n_in, ENVELOPE)
+    problem = comment_text_problem(env.source)
+    if problem:
+        raise ArtifactError(f"{ENVELOPE}.source", problem)
     for name in ("min", "max"):
         arr = np.asarray(getattr(env, name))
         if arr.shape != (n_in,):
@@ -476,6 +498,9 @@ def _check_metadata(meta: Mapping) -> None:
         if isinstance(value, bool) or not isinstance(value, types):
             allowed = " or ".join("null" if t is type(None) else t.__name__ for t in types)
             raise ArtifactError(f"payload.metadata.{key}", f"expected {allowed}, got {type(value).__name__}")
+    problem = comment_text_problem(meta["creator"])
+    if problem:
+        raise ArtifactError("payload.metadata.creator", problem)
     mse = meta["test_mse"]
     if mse is not None and not (math.isfinite(mse) and mse >= 0):
         raise ArtifactError("payload.metadata.test_mse", f"must be a finite value >= 0, got {mse!r}")
@@ -619,8 +644,11 @@ class _Reader:
             self.fail(path, f"expected a hex-float string such as \"0x1.99999ap-4\", got {_json_type(value)}")
         try:
             x = float.fromhex(value)
-        except ValueError:
-            self.fail(path, f"{value!r} is not a hex float")
+        except (ValueError, OverflowError):
+            self.fail(path, f"{_clip(value)!r} is not a hex float within float64")
+        if hex_float(x) != value:
+            self.fail(path, f"{_clip(value)!r} is not in canonical form: write {hex_float(x)!r} "
+                            "(Python float.hex without trailing zeros; the seal hashes this text)")
         if float32 and not is_float32_exact(x):
             self.fail(path, f"{value} is not exactly representable in float32")
         return x
@@ -636,6 +664,10 @@ class _Reader:
         if len(items) != rows:
             self.fail(path, f"shape mismatch: expected {rows} rows ({meaning}), got {len(items)}")
         return np.stack([self.vector(r, f"{path}[{i}]", cols) for i, r in enumerate(items)]).reshape(rows, cols)
+
+
+def _clip(text: str, n: int = 40) -> str:
+    return text if len(text) <= n else text[:n - 3] + "..."
 
 
 def _json_type(value) -> str:
@@ -699,7 +731,7 @@ def from_document(doc: Any, source: str | None = None) -> Artifact:
     r.obj(doc, "", ("format", "version", "sha256", "payload"))
     if doc["format"] != FORMAT:
         r.fail("format", f"expected {FORMAT!r}, got {doc['format']!r}")
-    if doc["version"] != VERSION or isinstance(doc["version"], bool):
+    if type(doc["version"]) is not int or doc["version"] != VERSION:
         r.fail("version", f"unsupported artifact version {doc['version']!r} (this staregen reads version {VERSION})")
     payload = r.obj(doc["payload"], "payload", ("network", "normalisation", "envelope", "outputs", "metadata"))
     network = r.obj(payload["network"], NETWORK, ("sizes", "activations", "layers"))
@@ -721,6 +753,8 @@ def from_document(doc: Any, source: str | None = None) -> Artifact:
     except ArtifactError as exc:
         raise ArtifactError(exc.field_path, exc.reason, source) from None
     _check_seal(r, doc)
+    if artifact.sha256 != doc["sha256"]:   # every value canonical, so this holds unless a rule is missing
+        r.fail("payload", "not in canonical form: its values re-serialise to another text than the sealed one")
     return artifact
 
 
@@ -738,20 +772,55 @@ def load(path: str | os.PathLike) -> Artifact:
     """Read and validate an artifact file; any problem raises ArtifactError naming the field."""
     path = Path(path)
     try:
+        if path.stat().st_size > MAX_FILE_BYTES:
+            raise ArtifactError("file", f"larger than {MAX_FILE_BYTES} bytes", str(path))
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise ArtifactError("file", "no such file", str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ArtifactError("file", f"cannot read: {exc}", str(path)) from None
+    return from_document(parse_json(text, str(path)), str(path))
+
+
+MAX_FILE_BYTES = 64 << 20
+MAX_DEPTH = 32
+
+
+def parse_json(text: str, source: str | None = None):
+    """Strict JSON: no NaN/Infinity constants, no duplicate keys, at most MAX_DEPTH levels of nesting."""
+    depth = current = 0
+    in_string = escaped = False
+    for ch in text:   # nesting depth, counted before the recursive parser sees it
+        if in_string:
+            escaped = not escaped and ch == "\\"
+            in_string = escaped or ch != '"'
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            current += 1
+            depth = max(depth, current)
+        elif ch in "]}":
+            current -= 1
+    if depth > MAX_DEPTH:
+        raise ArtifactError("file", f"not valid JSON: nested deeper than {MAX_DEPTH} levels", source)
     try:
-        doc = json.loads(text, parse_constant=_reject_constant)
-    except ValueError as exc:
-        raise ArtifactError("file", f"not valid JSON: {exc}", str(path)) from None
-    return from_document(doc, str(path))
+        return json.loads(text, parse_constant=_reject_constant, object_pairs_hook=_unique_keys)
+    except (ValueError, RecursionError) as exc:
+        raise ArtifactError("file", f"not valid JSON: {str(exc).splitlines()[0] if str(exc) else 'too deep'}",
+                            source) from None
 
 
 def _reject_constant(name: str):
     raise ValueError(f"{name} is not JSON")
+
+
+def _unique_keys(pairs: list) -> dict:
+    seen = {}
+    for key, value in pairs:
+        if key in seen:
+            raise ValueError(f"duplicate key {_clip(key)!r}")
+        seen[key] = value
+    return seen
 
 
 def summary(a: Artifact) -> str:

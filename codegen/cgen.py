@@ -15,7 +15,7 @@ import jinja2
 import numpy as np
 
 from codegen import atomic
-from codegen.artifact import hex_float
+from codegen.artifact import comment_text_problem, hex_float
 from codegen.errors import CodegenError
 
 SHARED_TEMPLATES = Path(__file__).with_name("templates")
@@ -29,6 +29,15 @@ def c_float(value) -> str:
     if not np.isfinite(v):
         raise CodegenError(f"cannot emit the non-finite constant {v} as a C literal")
     return hex_float(float(v)) + "f"
+
+
+def comment(text) -> str:
+    """Text that goes into a C comment, checked again at emission (the artifact loader checks it
+    first): printable ASCII without '*/', '/*', '??' or a trailing backslash."""
+    problem = comment_text_problem(text)
+    if problem:
+        raise CodegenError(f"comment text {str(text)[:40]!r}: {problem}")
+    return text
 
 
 def check_name(name: str) -> str:

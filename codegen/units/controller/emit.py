@@ -15,7 +15,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION
 from codegen.units.controller import spec as cs
 from codegen.artifact import Artifact
-from codegen.cgen import c_float, check_name, environment
+from codegen.cgen import c_float, check_name, comment, environment
 from codegen.units.network.emit import network_sources
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -63,7 +63,7 @@ def controller_context(a: Artifact, cfg: cs.ControllerConfig, name: str) -> dict
     return {
         "name": name, "P": name.upper(), "net": net_name(name), "n_in": a.n_in,
         "generator_version": GENERATOR_VERSION, "sha256": a.sha256,
-        "creator": str(a.metadata.get("creator", "")),
+        "creator": comment(a.metadata.get("creator", "")),
         "status_pid": cs.STATUS_PID, "status_bounds_mask": cs.STATUS_BOUNDS_MASK,
         "status_invalid": cs.STATUS_INPUT_INVALID, "status_saturated": cs.STATUS_SATURATED,
         "status_dwell": cs.STATUS_DWELL, "lat_bam_max": cs.LAT_BAM_MAX, "status_state_repaired": cs.STATUS_STATE_REPAIRED,

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from codegen import GENERATOR_VERSION
 from codegen.artifact import Artifact
-from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
+from codegen.cgen import c_float, check_name, comment, environment, math_sources, write_sources
 
 TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_NAME = "network"
@@ -26,7 +26,7 @@ LOAD_GROUP = 13
 def _labels(names, units, descriptions, lows=None, highs=None) -> list[dict]:
     rows = []
     for i, (n, u, d) in enumerate(zip(names, units, descriptions)):
-        row = {"index": i, "name": n, "unit": u, "description": d}
+        row = {"index": i, "name": comment(n), "unit": comment(u), "description": comment(d)}
         if lows is not None:
             row.update(min=f"{float(lows[i]):.9g}", max=f"{float(highs[i]):.9g}")
         rows.append(row)
@@ -63,8 +63,8 @@ def template_context(a: Artifact, name: str) -> dict:
         "name": name, "P": name.upper(),
         "n_in": a.n_in, "n_hidden": a.n_hidden, "n_out": a.n_out,
         "sha256": a.sha256, "generator_version": GENERATOR_VERSION,
-        "creator": str(a.metadata.get("creator", "")),
-        "envelope_source": env.source,
+        "creator": comment(a.metadata.get("creator", "")),
+        "envelope_source": comment(env.source),
         "inputs": _labels(env.names, env.units, env.descriptions, env.min, env.max),
         "outputs": _labels(out.names, out.units, out.descriptions),
         "neurons": _neurons(a),
