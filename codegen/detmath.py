@@ -89,6 +89,15 @@ _TANH_TAB = _load_tanh_table()
 _TANH_COLS = tuple(np.ascontiguousarray(_TANH_TAB[:, j]) for j in range(6))  # fast 1-D take
 
 
+CANONICAL_NAN_BITS = 0x7FC00000
+
+
+def canonf(x) -> np.ndarray:
+    """sg_canonf: x, or the canonical quiet NaN (bits 0x7FC00000) where x is a NaN."""
+    x = _f32(x)
+    return np.where(np.isnan(x), np.uint32(CANONICAL_NAN_BITS).view(np.float32), x)
+
+
 def tanhf(x) -> np.ndarray:
     """Mirror of sg_tanhf (and of sg_inline_tanhf, its inlined form): interval table indexed by
     exponent + 3 mantissa bits, degree-4 polynomial in |x| - c; x itself below 2^-12 and for

@@ -105,12 +105,6 @@ def words(a: np.ndarray) -> np.ndarray:
     return a.view(np.uint32).reshape(a.shape[0], -1)
 
 
-def float_words(dtype: np.dtype) -> np.ndarray:
-    """Per 32-bit word of a record: True where it is a float32 (bit comparisons let NaN match NaN there)."""
-    return np.concatenate([np.full(dtype.fields[name][0].itemsize // 4, dtype.fields[name][0].base == np.float32)
-                           for name in dtype.names])
-
-
 class Unit(ABC):
     """One generated unit bound to its inputs (artifact, parameters, configuration)."""
 

@@ -387,4 +387,18 @@ static SG_ALWAYS_INLINE float sg_logf_tab(float x)
     return kf * 0x1.62e4p-1f + (kf * 0x1.7f7d1cp-20f + lz);
 }
 
+/* x, or the one canonical quiet NaN 0x7FC00000 when x is a NaN. Every generated output that can
+ * be NaN passes through it, so golden, x86 and ARM agree bit for bit on NaN too (x86 makes
+ * negative default NaNs, ARM positive ones, and payloads propagate per target). */
+#define SG_CANONICAL_NAN_BITS 0x7FC00000u
+static inline float sg_canonf(float x)
+{
+    sg_bits_t b;
+    b.f = x;
+    if (x != x) {
+        b.u = SG_CANONICAL_NAN_BITS;
+    }
+    return b.f;
+}
+
 #endif /* SG_MATH_H */

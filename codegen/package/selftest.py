@@ -3,11 +3,10 @@
 For each unit, N vectors drawn from its gate classes (every class present, in the gate's
 proportions; vector 0 is the first class's, the timing reference) are run through the golden
 model; the C holds {state in, input, expected output, expected state out} as uint32 words and
-`int <name>_selftest(void)` replays them through the flight step, counting mismatching words.
-Float words compare bit for bit except that any NaN matches any NaN (the gate's rule: x86 and
-ARM make default NaNs of different sign). Four floating-point environment checks (subnormals
-kept, round to nearest in both directions, no fused multiply-add in the self-test's own
-translation unit) add one each when they fail, so a board whose start-up code set flush-to-zero
+`int <name>_selftest(void)` replays them through the flight step, counting mismatching words,
+every bit compared (NaN outputs are canonical on every target). Four floating-point environment
+checks (subnormals kept, round to nearest in both directions, no fused multiply-add in the
+self-test's own translation unit) add one each when they fail, so a board whose start-up code set flush-to-zero
 or a directed rounding mode fails the self-test even where the vectors would not show it.
 """
 from __future__ import annotations
@@ -20,7 +19,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION
 from codegen.cgen import check_name, environment
 from codegen.errors import CodegenError
-from codegen.unit import Unit, float_words, words
+from codegen.unit import Unit, words
 
 TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_VECTORS = 256
@@ -57,11 +56,6 @@ def make_vectors(unit: Unit, n: int = DEFAULT_VECTORS, seed: int = 0) -> Selftes
     return SelftestVectors(unit, state, inputs, out, after, {c: int(b.input.shape[0]) for c, b in classes.items()})
 
 
-def float_mask(dtype: np.dtype) -> list[int]:
-    """Per 32-bit word of a record: 1 where it is a float32 (NaN matches NaN), else 0."""
-    return [int(f) for f in float_words(dtype)]
-
-
 def _rows(v: SelftestVectors) -> list[list[str]]:
     parts = [words(v.input), words(v.output)]
     if v.unit.stateful:
@@ -89,7 +83,6 @@ def _unit_context(v: SelftestVectors) -> dict:
         "state_t": u.c_types.get("state", ""),
         "input_words": u.input_dtype.itemsize // 4, "output_words": u.output_dtype.itemsize // 4,
         "state_words": st.itemsize // 4 if st is not None else 0,
-        "out_mask": float_mask(u.output_dtype) + (float_mask(st) if st is not None else []),
         "rows": _rows(v),
         "input_fields": field_elements(u.input_dtype),
         "state_fields": field_elements(st) if st is not None else [],

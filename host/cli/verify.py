@@ -4,7 +4,7 @@ the bit-exact gate of a generated unit (tools/gate.py).
 Golden model vs the generated C on N seeded vectors in the unit's classes (inside the envelope,
 on and around its bounds, outside it, special values, ...) and, for a stateful unit, S sequences
 of --steps consecutive steps from init. Every output field and the state are compared as bit
-patterns (NaN as a class); exit 1 on any mismatch. The old spellings `verify --controller` and
+patterns, every bit (NaN outputs are canonical); exit 1 on any mismatch. The old spellings `verify --controller` and
 `staregen tanh gate` still work for one release.
 """
 from __future__ import annotations

@@ -241,6 +241,9 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     status |= np.where(sat, U32(cs.STATUS_SATURATED), U32(0))
     out["torque"] = clip(cmd, lim)
     out["status"] = status | np.where(repaired, U32(cs.STATUS_STATE_REPAIRED), U32(0))
+    # canonical NaN diagnostics (the C canonicalises where it computes them; downstream, a NaN only
+    # fails comparisons and is zeroed by the PID, so its bits matter nowhere else)
+    out["A_bd"], out["omega_e"] = dm.canonf(out["A_bd"]), dm.canonf(out["omega_e"])
     new = np.zeros(inp.shape, dtype=STATE_DTYPE)
     new["integral"], new["mode"], new["clean"] = integral, mode, count
     return out, new

@@ -35,9 +35,9 @@ def field_docs(cfg: cs.ControllerConfig) -> dict[str, list[FieldDoc]]:
             FieldDoc("torque", "N*m", "S_b", f"always finite, |torque_i| <= {lim} (the configured limit)",
                      "commanded wheel torque; hold it for the control period"),
             FieldDoc("status", "bits", "-", "STATUS_* below", "what flew and why"),
-            FieldDoc("A_bd", "rad", "S_b w.r.t. S_d", "NaN possible on invalid input",
+            FieldDoc("A_bd", "rad", "S_b w.r.t. S_d", "NaN possible on invalid input (always the canonical 0x7FC00000)",
                      "diagnostics: 3-1-2 Euler attitude error w.r.t. the desired frame"),
-            FieldDoc("omega_e", "rad/s", "S_b", "NaN possible on invalid input",
+            FieldDoc("omega_e", "rad/s", "S_b", "NaN possible on invalid input (always the canonical 0x7FC00000)",
                      "diagnostics: rate error omega_b - omega_d"),
         ],
         "state": [

@@ -80,7 +80,7 @@ def denormalise(a: Artifact, yn: np.ndarray) -> np.ndarray:
     with np.errstate(all="ignore"):
         shifted = _f32(yn - np.float32(m.ymin), "denormalise subtract")
         scaled = _f32(shifted / _f32(m.gain, "gain"), "denormalise divide")
-        return _f32(scaled + _f32(m.xoffset, "xoffset"), "denormalise add")
+        return detmath.canonf(_f32(scaled + _f32(m.xoffset, "xoffset"), "denormalise add"))
 
 
 def network_eval(a: Artifact, x: np.ndarray) -> np.ndarray:

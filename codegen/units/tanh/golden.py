@@ -189,12 +189,12 @@ def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray
                                                  vec("wdot_t"))
         ok = state_ok & inputs_ok
         zero = np.zeros(inp.shape[0], dtype=F32)
-        result_ok = sum_is_finite(u + vdot)
+        result_ok = sum_is_finite(u + vdot + x1 + x2)   # telemetry too: no output is ever NaN or Inf
         keep = ok & result_ok
         u = tuple(np.where(keep, c, zero) for c in u)
         vdot = tuple(np.where(keep, c, zero) for c in vdot)
-        x1 = tuple(np.where(ok, c, zero) for c in x1)
-        x2 = tuple(np.where(ok, c, zero) for c in x2)
+        x1 = tuple(np.where(keep, c, zero) for c in x1)
+        x2 = tuple(np.where(keep, c, zero) for c in x2)
         status = np.where(keep, status, np.uint32(STATUS_INVALID_INPUT)).astype(np.uint32)
         varpi = tuple(np.where(state_ok, c, zero) for c in varpi)
         new = []

@@ -142,3 +142,25 @@ def check_records_are_independent(unit: Unit) -> None:
     rev = Batch(None if b.state is None else b.state[::-1].copy(), b.input[::-1].copy())
     out_rev, _ = runner(unit, "arm").records(rev)
     assert compare_fields(out[::-1].copy(), out_rev) == []
+
+
+CANONICAL_NAN = 0x7FC00000
+
+
+def check_nan_outputs_are_canonical(unit: Unit) -> int:
+    """Every float output word that is a NaN is the canonical 0x7FC00000, in the golden model and in
+    the x86 C, over the gate classes (special values included): the gate needs no NaN class.
+    Returns how many NaN words it saw."""
+    x86 = X86Runner(unit)
+    seen = 0
+    for batch in unit.gate_classes(4_000, seed=11).values():
+        for out in (unit.golden(batch.state, batch.input)[0], x86.records(batch)[0]):
+            for name in out.dtype.names:
+                values = np.ascontiguousarray(out[name])
+                if values.dtype.base != np.float32:
+                    continue
+                bits = values.view(np.uint32)
+                nan = np.isnan(values)
+                seen += int(nan.sum())
+                assert np.all(bits[nan] == CANONICAL_NAN), (unit.kind, name, hex(int(bits[nan][0])))
+    return seen

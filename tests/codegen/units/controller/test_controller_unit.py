@@ -73,7 +73,7 @@ def test_three_way_gate_independent_steps(unit, artifact, cfg, vectors):
     g_out, g_state = gc.step(artifact, cfg, states, inputs)
     for out, st in on_targets(unit, states, inputs):
         assert same(g_out, g_state, out, st)
-        # uint32 patterns, NaN as a class, on the torque itself
+        # uint32 patterns, every bit, on the torque itself
         assert np.array_equal(g_out["torque"].view(np.uint32), out["torque"].view(np.uint32))
     # every class exercised both laws
     pid = (g_out["status"] & cs.STATUS_PID) != 0
