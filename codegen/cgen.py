@@ -70,8 +70,18 @@ def math_sources() -> dict[str, str]:
 
 
 def write_sources(sources: dict[str, str], out_dir: str | os.PathLike) -> list[Path]:
-    """Write each file atomically into out_dir (created if needed); other files there are left alone."""
+    """Write every file into out_dir (created if needed) all or nothing: each target is checked
+    first (a directory or an unwritable place in the way is one CodegenError and nothing is
+    written), then all are written to temporary siblings and renamed into place. Other files in
+    out_dir are left alone."""
     out_dir = Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
         raise CodegenError(f"--out: {out_dir} exists and is not a directory")
-    return [atomic.write_text(out_dir / fname, text) for fname, text in sorted(sources.items())]
+    targets = [out_dir / fname for fname in sorted(sources)]
+    for path in targets:
+        if path.is_symlink() or (path.exists() and not path.is_file()):
+            raise CodegenError(f"--out: {path} exists and is not a regular file; nothing was written")
+    try:
+        return atomic.write_files({path: sources[path.name].encode("utf-8") for path in targets})
+    except OSError as exc:
+        raise CodegenError(f"--out: cannot write into {out_dir}: {exc.strerror or exc}; nothing was written") from None

@@ -13,6 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import re
 import shutil
 import subprocess
 import tempfile
@@ -23,6 +24,7 @@ from typing import Mapping, Sequence
 import jinja2
 
 from firmware import symbols
+from firmware.cache import discard, file_sha256
 from firmware.errors import FirmwareError
 from firmware.flags import ARM_CC, ARM_CPU, COMMON, with_opt
 
@@ -34,7 +36,7 @@ BENCH = HERE / "bench"
 ARM_NM = "arm-none-eabi-nm"
 ARM_SIZE = "arm-none-eabi-size"
 EXTRA_CFLAGS = ["-fstack-usage", "-ffunction-sections", "-fdata-sections"]
-BUILD_LAYOUT = "1"
+BUILD_LAYOUT = "2"   # 2: the manifest holds the ELF's sha256, checked before use
 
 # Names that would mean libm (or a vendor HAL) got linked in.
 _LIBM, _HAL = symbols.LIBM, symbols.HAL
@@ -129,7 +131,22 @@ def link(objects: list[Path], elf: Path, map_file: Path) -> bool:
         res = _link(objects, elf, map_file, ["-lc_nano", "-lgcc"])
         if res.returncode == 0:
             return True
-    raise FirmwareError(f"ARM build: link failed: {_one_line(res.stderr)}")
+    raise FirmwareError(f"ARM build: link failed: {_link_problem(res.stderr)}")
+
+
+_OVERFLOW = re.compile(r"region [`'](\w+)' overflowed by (\d+) bytes")
+_REGION_KB = {"FLASH": 1024, "SRAM": 128, "CCM": 64}
+
+
+def _link_problem(stderr: str) -> str:
+    """The linker's complaint in one line; a memory overflow names the region and the sizes."""
+    m = _OVERFLOW.search(stderr)
+    if m:
+        region, over = m.group(1), int(m.group(2))
+        size = _REGION_KB.get(region)
+        total = f" ({size} KB on the STM32F417, the image needs {size * 1024 + over} B)" if size else ""
+        return f"the image does not fit {region}: overflowed by {over} B{total}"
+    return _one_line(stderr)
 
 
 def check_symbols(elf: Path, allow_libm: bool = False) -> None:
@@ -153,13 +170,13 @@ def _build_into(folder: Path, files: Mapping[str, str], opt: str, peer: bool) ->
     if peer:  # third-party C calls libm (tanhf, expf) and newlib
         res = _link(objects, folder / "firmware.elf", folder / "firmware.map", ["-lm", "-lc_nano", "-lgcc"])
         if res.returncode != 0:
-            raise FirmwareError(f"ARM build: link failed: {_one_line(res.stderr)}")
+            raise FirmwareError(f"ARM build: link failed: {_link_problem(res.stderr)}")
         newlib = True
     else:
         newlib = link(objects, folder / "firmware.elf", folder / "firmware.map")
     check_symbols(folder / "firmware.elf", allow_libm=peer)
     manifest = {"flags": cflags(opt, peer), "cc": compiler_version(), "newlib": newlib, "peer": peer,
-                "files": sorted(files)}
+                "files": sorted(files), "elf_sha256": file_sha256(folder / "firmware.elf")}
     (folder / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
     return newlib
 
@@ -167,6 +184,14 @@ def _build_into(folder: Path, files: Mapping[str, str], opt: str, peer: bool) ->
 def _cache_root() -> Path:
     env = os.environ.get("STAREGEN_CACHE")
     return (Path(env).expanduser() if env else Path.home() / ".cache" / "staregen") / "arm"
+
+
+def _intact(folder: Path) -> bool:
+    try:
+        manifest = json.loads((folder / "manifest.json").read_text())
+        return file_sha256(folder / "firmware.elf") == manifest["elf_sha256"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
 
 
 def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool = False) -> ArmBuild:
@@ -182,6 +207,8 @@ def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool
                  "ld": LINKER_SCRIPT.read_text(), "files": sorted(files.items())}
     key = hashlib.sha256(json.dumps(key_parts, sort_keys=True).encode()).hexdigest()
     folder = _cache_root() / key
+    if folder.is_dir() and not _intact(folder):
+        discard(folder)   # a truncated or edited ELF must not be emulated or measured
     if not (folder / "manifest.json").is_file():
         folder.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=folder.parent))

@@ -28,13 +28,15 @@ from typing import Mapping
 import cffi
 
 from firmware import symbols
+from firmware.cache import discard, file_sha256
 from firmware.errors import FirmwareError
 from firmware.flags import COMMON
 
 X86_CC = "gcc"
 X86_FLAGS = [*COMMON, "-fPIC"]
-# Bump when the layout of a cache folder changes (2: every module carries the host helpers below).
-BUILD_LAYOUT = "2"
+# Bump when the layout of a cache folder changes (2: every module carries the host helpers below;
+# 3: the manifest holds the module's sha256, checked before loading).
+BUILD_LAYOUT = "3"
 
 # Host helpers appended to every cffi wrapper (never to the flight sources, which stay free of
 # intrinsics): read the SSE control register so a batch can refuse to run when something else in
@@ -177,7 +179,8 @@ def _build_into(folder: Path, key: str, sources: Mapping[str, str], cdef: str, h
     except Exception as exc:  # cffi raises VerificationError/CompileError/LinkError
         raise FirmwareError(f"x86 build: cffi wrapper failed: {_one_line(str(exc) or log.read_text())}") from None
     built.rename(folder / built.name)
-    manifest = {"key": key, "flags": X86_FLAGS, "cc": compiler_version(cc), "files": sorted(sources)}
+    manifest = {"key": key, "flags": X86_FLAGS, "cc": compiler_version(cc), "files": sorted(sources),
+                "module": built.name, "module_sha256": file_sha256(folder / built.name)}
     (folder / "manifest.json").write_text(json.dumps(manifest, indent=2) + "\n")
 
 
@@ -201,6 +204,15 @@ class _redirect_fds:
         os.dup2(self.saved[1], 2)
         os.close(self.saved[0])
         os.close(self.saved[1])
+        return False
+
+
+def cache_entry_intact(folder: Path) -> bool:
+    """The cached module is the one that was built: its sha256 matches the folder's manifest."""
+    try:
+        manifest = json.loads((folder / "manifest.json").read_text())
+        return file_sha256(folder / manifest["module"]) == manifest["module_sha256"]
+    except (OSError, ValueError, KeyError, TypeError):
         return False
 
 
@@ -228,6 +240,8 @@ def build(sources: Mapping[str, str], cdef: str, harness: str, cc: str = X86_CC)
         return _loaded[key]
     parent = cache_root() / "x86"
     folder = parent / key
+    if folder.is_dir() and not cache_entry_intact(folder):
+        discard(folder)   # truncated or edited module: loading it could crash the process (SIGBUS)
     if not folder.is_dir():
         parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=parent))
