@@ -578,9 +578,14 @@ def _tensor64(t) -> np.ndarray:
 def parse_shape(text: str) -> tuple[int, int, int]:
     """'12-40-3' -> (12, 40, 3)."""
     parts = text.split("-")
-    if len(parts) != 3 or not all(p.isdigit() and int(p) > 0 for p in parts):
-        raise CodegenError(f"--shape: expected N_IN-N_HIDDEN-N_OUT with positive integers (e.g. 12-40-3), got {text!r}")
+    if len(parts) != 3 or not all(p.isdigit() and len(p) <= 6 and 0 < int(p) <= MAX_LAYER_SIZE for p in parts):
+        raise CodegenError(f"--shape: expected N_IN-N_HIDDEN-N_OUT with integers in [1, {MAX_LAYER_SIZE}] "
+                           f"(e.g. 12-40-3), got {text[:40]!r}")
     return tuple(int(p) for p in parts)  # type: ignore[return-value]
+
+
+# Bigger layers cannot be flight code on the STM32F417 (12-10000-3 is 640 KB of weights of 1 MB flash).
+MAX_LAYER_SIZE = 10_000
 
 
 def random_artifact(shape: Sequence[int] = (12, 40, 3), seed: int = 0) -> Artifact:

@@ -36,8 +36,16 @@ COMMANDS = [
 ]
 
 
+class OneLineParser(argparse.ArgumentParser):
+    """argparse whose usage errors are one line (not the usage block), exit status 2; every
+    subparser inherits it (add_subparsers uses the parent's class)."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message.splitlines()[0] if message else 'bad arguments'}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="staregen",
         description="Staring-imaging attitude controllers: design on the ground, generate bit-exact flight C.",
     )
@@ -49,7 +57,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as exc:   # --help (0) or a usage error, already printed (2)
+        return exc.code if isinstance(exc.code, int) else 2
     try:
         return int(args.func(args) or 0)
     except USER_ERRORS as exc:
@@ -59,6 +70,10 @@ def main(argv: list[str] | None = None) -> int:
         # e.g. `staregen ... | head`: the reader went away; not an error of ours
         sys.stderr.close()
         return 0
+    except OSError as exc:   # a file system refusal (a folder in the way, /proc, ...): one line
+        where = f": {exc.filename}" if getattr(exc, "filename", None) else ""
+        print(f"staregen {args.command}: error: {exc.strerror or exc}{where}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print(f"staregen {args.command}: interrupted", file=sys.stderr)
         return 130

@@ -18,7 +18,8 @@ def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None
     return value
 
 
-def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False) -> float:
+def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False,
+                 minimum: float | None = None, maximum: float | None = None) -> float:
     try:
         value = float(text)
     except (TypeError, ValueError):
@@ -29,4 +30,8 @@ def parse_number(text: str, what: str, *, positive: bool = False, non_negative: 
         raise HostError(f"{what} must be positive, got {text}")
     if non_negative and value < 0:
         raise HostError(f"{what} must not be negative, got {text}")
+    if minimum is not None and value < minimum:
+        raise HostError(f"{what} must be at least {minimum:g}, got {text}")
+    if maximum is not None and value > maximum:
+        raise HostError(f"{what} must be at most {maximum:g}, got {text}")
     return value

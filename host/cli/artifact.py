@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 
 from codegen import artifact as art
+from host.cli.args import parse_int
 
 
 def register(subparsers) -> None:
@@ -16,7 +17,7 @@ def register(subparsers) -> None:
 
     random = actions.add_parser("random", help="write a randomly initialised (untrained) artifact")
     random.add_argument("--shape", default="12-40-3", help="N_IN-N_HIDDEN-N_OUT (default 12-40-3)")
-    random.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    random.add_argument("--seed", default="0", help="random seed (default 0)")
     random.add_argument("--out", required=True, metavar="FILE", help="artifact to write")
     random.set_defaults(func=run_random)
 
@@ -28,7 +29,8 @@ def run_check(args: argparse.Namespace) -> int:
 
 
 def run_random(args: argparse.Namespace) -> int:
-    a = art.random_artifact(art.parse_shape(args.shape), args.seed)
+    seed = parse_int(args.seed, "--seed", maximum=2**32 - 1)
+    a = art.random_artifact(art.parse_shape(args.shape), seed)
     path = a.save(args.out)
-    print(f"wrote {path}: {a.shape_text}, seed {args.seed}, sha256 {a.sha256}")
+    print(f"wrote {path}: {a.shape_text}, seed {seed}, sha256 {a.sha256}")
     return 0

@@ -39,6 +39,8 @@ def load_inputs(path: str, n_in: int) -> np.ndarray:
     if not isinstance(x, np.ndarray) or x.dtype != np.float32 or x.ndim != 2 or x.shape[1] != n_in:
         got = f"{x.dtype} {x.shape}" if isinstance(x, np.ndarray) else type(x).__name__
         raise HostError(f"--inputs: {path}: expected a float32 array of shape (N, {n_in}), got {got}")
+    if x.shape[0] == 0:
+        raise HostError(f"--inputs: {path}: no rows (shape {x.shape})")
     return np.ascontiguousarray(x)
 
 

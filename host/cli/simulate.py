@@ -21,6 +21,9 @@ from host.sim.targets import parse_target
 from codegen import atomic
 
 DEFAULT_DURATION_S = 100.0
+MAX_DURATION_S = 100_000.0    # a staring pass lasts minutes; this bounds memory (histories) too
+MIN_PERIOD_S, MAX_PERIOD_S = 1e-4, 10.0
+MIN_DT_S = 1e-6
 
 
 def register(subparsers) -> None:
@@ -65,7 +68,7 @@ def check_output_folder(out: Path, marker: str = "metrics.json") -> None:
 
 
 def build_config(args) -> SimConfig:
-    return SimConfig(duration=parse_number(args.duration, "--duration", positive=True),
+    return SimConfig(duration=parse_number(args.duration, "--duration", positive=True, maximum=MAX_DURATION_S),
                      seed=parse_int(args.seed, "--seed"))
 
 
@@ -79,12 +82,14 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     tanh: the float64 law (continuous without --period); tanh-c / tanh-arm: the generated C in the
     loop (SIL / PIL, --period default 0.1 s) compared with the float64 sampled run."""
     duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else "40",
-                            "--duration", positive=True)
+                            "--duration", positive=True, maximum=MAX_DURATION_S)
     in_loop = {"tanh-c": "x86", "tanh-arm": "arm"}.get(args.controller)
-    period = None if args.period is None else parse_number(args.period, "--period", positive=True)
+    period = None if args.period is None else parse_number(args.period, "--period", minimum=MIN_PERIOD_S,
+                                                              maximum=MAX_PERIOD_S)
     if in_loop and period is None:
         period = 0.1
-    dt = parse_number(args.dt or str(tanh_example.MAX_REFERENCE_STEP), "--dt", positive=True)
+    dt = parse_number(args.dt or str(tanh_example.MAX_REFERENCE_STEP), "--dt", positive=True, minimum=MIN_DT_S,
+                      maximum=MAX_PERIOD_S)
     out = Path(args.out)
     check_output_folder(out)
     try:

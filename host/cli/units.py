@@ -30,7 +30,8 @@ def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network"
 
 
 def deprecated(old: str, new: str) -> None:
-    print(f"staregen: '{old}' is deprecated and will be removed; use '{new}'", file=sys.stderr)
+    # stdout: stderr carries exactly one line, and only for an error
+    print(f"staregen: '{old}' is deprecated and will be removed; use '{new}'")
 
 
 def unit_from_args(args: argparse.Namespace) -> Unit:

@@ -25,6 +25,7 @@ from codegen.units.controller import spec as cs
 from host.core.constants import DEG, MU_EARTH, WGS84_A, WGS84_E2
 from host.control.controllers import ControlOutput, Measurement
 from host.control.pid import TABLE1_GAINS
+from host.errors import HostError
 from host.gnc.preprocess import preprocess
 from host.plant.spacecraft import TABLE6
 from host.core.timebase import gmst_rate
@@ -134,6 +135,8 @@ class NnController:
     name = "nn"
 
     def __init__(self, artifact: art.Artifact, cfg: cs.ControllerConfig):
+        if artifact.sizes[0] != 12 or artifact.sizes[2] != 3:
+            raise HostError(f"the network controller needs a 12-input, 3-output network, got {artifact.shape_text}")
         self.artifact, self.cfg = artifact, cfg
         self.modes = ModeLogic(cfg.dwell_steps)
         self.pid = TrackingPid(cfg)

@@ -40,6 +40,9 @@ class NetworkUnit(Unit):
     def field_docs(self):
         return interface.field_docs(self.artifact)
 
+    def status_bits(self):
+        return interface.status_bits()
+
     @property
     def step_symbol(self) -> str:
         return f"{self.entry}_eval"

@@ -50,9 +50,12 @@ class Constants32:
             raise AttributeError(name) from None
 
 
+MIN_PERIOD_S, MAX_PERIOD_S = 1e-4, 10.0   # T is baked in as a float32 and multiplies rates
+
+
 def check_period(period: float) -> float:
-    if not (isinstance(period, (int, float)) and math.isfinite(period) and period > 0):
-        raise CodegenError(f"control period must be a positive number of seconds, got {period!r}")
+    if not (isinstance(period, (int, float)) and math.isfinite(period) and MIN_PERIOD_S <= period <= MAX_PERIOD_S):
+        raise CodegenError(f"control period must be in [{MIN_PERIOD_S:g}, {MAX_PERIOD_S:g}] s, got {period!r}")
     return float(period)
 
 

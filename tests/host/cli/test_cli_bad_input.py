@@ -1,0 +1,160 @@
+"""Issue 14 defect 4: every subcommand refuses bad input with exit 2, exactly one line on stderr,
+no traceback and no new file. Placeholders: {net} a valid 12-40-3 artifact, {small} a valid 3-5-1
+one, {file} an existing file, {dir} an existing folder, {x} a (5, 12) float32 .npy, {x0} a (0, 12)
+one, {cfg} a valid controller.toml, {deep} an artifact nested 100000 deep."""
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from codegen.artifact import random_artifact
+from host.cli import main
+from host.control.nn_controller import CONFIG_SOURCES, default_package_config
+from codegen.package import config as pc
+
+CASES = [
+    # argparse itself: one line, not the usage block
+    ([], "the following arguments are required"),
+    (["nonsense"], "invalid choice"),
+    (["simulate", "--bogus"], "unrecognized arguments"),
+    (["verify", "--target", "riscv"], "invalid choice"),
+    (["cycles", "--mode", "fast"], "invalid choice"),
+    (["samples"], "the following arguments are required: --n"),
+    (["train"], "the following arguments are required"),
+    (["artifact"], "the following arguments are required"),
+    (["config"], "the following arguments are required"),
+    (["package"], "the following arguments are required"),
+    (["generate", "--config", "{cfg}"], "the following arguments are required"),
+    # seeds and counts
+    (["artifact", "random", "--seed", "-1", "--out", "{tmp}/a.json"], "--seed"),
+    (["artifact", "random", "--seed", "x", "--out", "{tmp}/a.json"], "--seed"),
+    (["verify", "--artifact", "{net}", "--seed", "-1"], "--seed"),
+    (["verify", "--artifact", "{net}", "--vectors", "1e13"], "--vectors"),
+    (["verify", "--artifact", "{net}", "--vectors", "10000000000000"], "--vectors"),
+    (["verify", "--artifact", "{net}", "--vectors", "0"], "--vectors"),
+    (["verify", "--unit", "controller", "--artifact", "{net}", "--sequences", "-2"], "--sequences"),
+    (["verify", "--unit", "controller", "--artifact", "{net}", "--steps", "2"], "--steps"),
+    (["tanh", "gate", "--params", "docs/tanh_paper000.toml", "--seed", "-1"], "--seed"),
+    (["verify", "--unit", "tanh", "--params", "docs/tanh_paper000.toml", "--period", "1e-300"], "period"),
+    (["verify", "--unit", "tanh", "--params", "docs/tanh_paper000.toml", "--period", "-1"], "--period"),
+    (["verify", "--unit", "tanh", "--params", "docs/tanh_paper000.toml", "--period", "nan"], "--period"),
+    (["cycles", "--artifact", "{net}", "--per-class", "0"], "--per-class"),
+    (["cycles", "--artifact", "{net}", "--per-class", "1e9"], "--per-class"),
+    (["cycles", "--artifact", "{net}", "--seed", "-5"], "--seed"),
+    (["samples", "--n", "0", "--out", "{tmp}/s"], "--n"),
+    (["samples", "--n", "-3", "--out", "{tmp}/s"], "--n"),
+    (["samples", "--n", "1e15", "--out", "{tmp}/s"], "--n"),
+    (["samples", "--n", "10", "--seed", "-1", "--out", "{tmp}/s"], "seed"),
+    (["samples", "--n", "10", "--workers", "0", "--out", "{tmp}/s"], "--workers"),
+    (["samples", "--n", "10", "--shard-size", "0", "--out", "{tmp}/s"], "shard"),
+    (["samples", "--n", "10", "--torque-bound", "-1", "--out", "{tmp}/s"], "torque"),
+    (["train", "--data", "{tmp}/missing", "--out", "{tmp}/n.json"], "missing"),
+    (["train", "--data", "{dir}", "--out", "{tmp}/n.json", "--epochs", "0"], "--epochs"),
+    (["train", "--data", "{dir}", "--out", "{tmp}/n.json", "--hidden", "0"], "--hidden"),
+    (["train", "--data", "{dir}", "--out", "{tmp}/n.json", "--seed", "-1"], "--seed"),
+    # simulate
+    (["simulate", "--duration", "1e12", "--out", "{tmp}/o"], "--duration"),
+    (["simulate", "--duration", "-1", "--out", "{tmp}/o"], "--duration"),
+    (["simulate", "--duration", "inf", "--out", "{tmp}/o"], "--duration"),
+    (["simulate", "--seed", "-1", "--out", "{tmp}/o"], "seed"),
+    (["simulate", "--controller", "tanh", "--period", "1e-300", "--out", "{tmp}/o"], "period"),
+    (["simulate", "--controller", "tanh", "--dt", "0", "--out", "{tmp}/o"], "--dt"),
+    (["simulate", "--controller", "nn", "--artifact", "{small}", "--out", "{tmp}/o"], "12-input"),
+    (["simulate", "--controller", "nn-c", "--artifact", "{small}", "--out", "{tmp}/o"], "12-input"),
+    (["simulate", "--controller", "nn", "--artifact", "{tmp}/none.json", "--out", "{tmp}/o"], "no such file"),
+    (["simulate", "--target", "200,0", "--out", "{tmp}/o"], "below the horizon"),
+    (["simulate", "--t-img", "0", "--out", "{tmp}/o"], "--t-img"),
+    (["simulate", "--workers", "0", "--target", "all", "--out", "{tmp}/o"], "--workers"),
+    (["simulate", "--out", "{file}"], "not a directory"),
+    (["simulate", "--out", "/proc/staregen"], "output folder"),
+    # impulse
+    (["impulse", "--controller", "nn", "--artifact", "{small}", "--out", "{tmp}/o"], "12-input"),
+    (["impulse", "--duration", "5", "--out", "{tmp}/o"], "--duration"),
+    (["impulse", "--seed", "-1", "--out", "{tmp}/o"], "seed"),
+    (["impulse", "--controller", "nope", "--out", "{tmp}/o"], "controller"),
+    # artifacts
+    (["artifact", "check", "{tmp}/none.json"], "no such file"),
+    (["artifact", "check", "{deep}"], "nested deeper"),
+    (["artifact", "check", "{dir}"], "cannot read"),
+    (["artifact", "random", "--shape", "12-100000000-3", "--out", "{tmp}/a.json"], "--shape"),
+    (["artifact", "random", "--shape", "12-0-3", "--out", "{tmp}/a.json"], "--shape"),
+    (["artifact", "random", "--shape", "12-x-3", "--out", "{tmp}/a.json"], "--shape"),
+    (["artifact", "random", "--out", "{dir}"], "directory"),
+    (["artifact", "random", "--out", "{file}/a.json"], "File exists"),
+    (["artifact", "random", "--out", "/proc/a.json"], "a.json"),
+    # codegen / c-eval / cycles outputs
+    (["codegen", "--artifact", "{net}", "--out", "{file}"], "not a directory"),
+    (["codegen", "--artifact", "{net}", "--out", "/proc/staregen"], "--out"),
+    (["codegen", "--artifact", "{net}", "--name", "Bad Name", "--out", "{tmp}/c"], "--name"),
+    (["codegen", "--unit", "tanh", "--artifact", "{net}", "--out", "{tmp}/c"], "--artifact does not apply"),
+    (["codegen", "--unit", "tanh", "--out", "{tmp}/c"], "--params"),
+    (["codegen", "--unit", "tanh", "--params", "{file}", "--out", "{tmp}/c"], ".toml or .json"),
+    (["tanh", "codegen", "--params", "docs/tanh_paper000.toml", "--out", "{file}"], "not a directory"),
+    (["c-eval", "--artifact", "{net}", "--inputs", "{x}", "--out", "{dir}", "--target", "x86"], "directory"),
+    (["c-eval", "--artifact", "{net}", "--inputs", "{x}", "--out", "{file}/y.npy", "--target", "x86"], "File exists"),
+    (["c-eval", "--artifact", "{net}", "--inputs", "{x0}", "--out", "{tmp}/y.npy", "--target", "arm"], "no rows"),
+    (["c-eval", "--artifact", "{net}", "--inputs", "{file}", "--out", "{tmp}/y.npy", "--target", "x86"], "inputs"),
+    (["c-eval", "--artifact", "{small}", "--inputs", "{x}", "--out", "{tmp}/y.npy", "--target", "x86"], "(N, 3)"),
+    (["cycles", "--artifact", "{net}", "--json", "{dir}"], "directory"),
+    (["cycles", "--artifact", "{net}", "--json", "/proc/c.json"], "c.json"),
+    (["cycles", "--unit", "controller", "--artifact", "{small}"], "12-input"),
+    (["cycles", "--entry", "controller", "--artifact", "{small}"], "12-input"),
+    (["verify", "--controller", "--artifact", "{small}"], "12-input"),
+    (["verify", "--unit", "controller", "--artifact", "{small}"], "12-input"),
+    # configuration and packages
+    (["config", "init", "--out", "{dir}"], "exists"),
+    (["config", "init", "--out", "{file}/c.toml"], "c.toml"),
+    (["config", "init", "--name", "Bad", "--out", "{tmp}/c.toml"], "--name"),
+    (["config", "check", "{tmp}/none.toml"], "cannot read"),
+    (["config", "check", "{net}"], "not valid TOML"),
+    (["config", "seal", "{file}"], "not valid TOML"),
+    (["generate", "--config", "{cfg}", "--network", "{small}", "--out", "{tmp}/p"], "12-input"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{file}"], "not a directory"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--vectors", "0"], "--vectors"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--gate-vectors", "1e12"], "--gate-vectors"),
+    (["generate", "--config", "{net}", "--network", "{net}", "--out", "{tmp}/p"], "not valid TOML"),
+    (["package", "check", "{dir}"], "manifest.json"),
+    (["package", "check", "{file}"], "not a directory"),
+]
+
+
+@pytest.fixture()
+def places(tmp_path, monkeypatch):
+    monkeypatch.chdir(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(__file__)))))
+    random_artifact((12, 40, 3), seed=1).save(tmp_path / "net.json")
+    random_artifact((3, 5, 1), seed=1).save(tmp_path / "small.json")
+    (tmp_path / "file.txt").write_text("just a file\n")
+    (tmp_path / "folder").mkdir()
+    np.save(tmp_path / "x.npy", np.zeros((5, 12), np.float32))
+    np.save(tmp_path / "x0.npy", np.zeros((0, 12), np.float32))
+    pc.write(default_package_config(), tmp_path / "controller.toml", CONFIG_SOURCES)
+    (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
+    return {"tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
+            "file": str(tmp_path / "file.txt"), "dir": str(tmp_path / "folder"), "x": str(tmp_path / "x.npy"),
+            "x0": str(tmp_path / "x0.npy"), "cfg": str(tmp_path / "controller.toml"), "deep": str(tmp_path / "deep.json")}
+
+
+def snapshot(root: str) -> set[str]:
+    return {os.path.join(d, f) for d, dirs, files in os.walk(root) for f in files + dirs}
+
+
+def test_there_are_enough_cases():
+    assert len(CASES) >= 80
+    assert {argv[0] for argv, _ in CASES if argv} >= {"simulate", "samples", "train", "artifact", "codegen", "c-eval",
+                                                       "verify", "cycles", "impulse", "tanh", "config", "generate",
+                                                       "package"}
+
+
+@pytest.mark.parametrize("argv, message", CASES, ids=[" ".join(a)[:60] or "(none)" for a, _ in CASES])
+def test_bad_input_is_one_line_exit_2_no_file(places, capsys, argv, message):
+    argv = [a.format(**places) for a in argv]
+    before = snapshot(places["tmp"])
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 2, (code, err)
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert message in err, err
+    assert snapshot(places["tmp"]) == before
+
