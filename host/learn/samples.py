@@ -213,13 +213,24 @@ def _read_json(path: Path, what: str) -> dict:
         raise HostError(f"{path}: unreadable {what} ({type(exc).__name__})") from None
 
 
-def read_shard(directory: Path, index: int, config_hash: str, expected_count: int) -> tuple[dict, dict]:
-    """The arrays and sidecar of a finished shard; a damaged or foreign shard is a HostError."""
+def read_shard(directory: Path, plan: "DatasetPlan", index: int) -> tuple[dict, dict]:
+    """The arrays and sidecar of a finished shard; a damaged, foreign, swapped or edited shard is a
+    HostError. The sidecar is bound to its place in the dataset (index, first sample, count, seeds,
+    config hash), the npz to the sidecar (size, sha256), and the content to the index: the inputs
+    must be the ones the shard's seed draws, and the statistics the ones its arrays give."""
     npz_path, json_path = shard_paths(directory, index)
     sidecar = _read_json(json_path, "shard sidecar")
+    config_hash, expected_count = plan.config_hash(), plan.shard_count(index)
     if sidecar.get("config_hash") != config_hash:
         raise HostError(f"{json_path}: config hash {str(sidecar.get('config_hash'))[:12]}… does not match "
                         f"the dataset's {config_hash[:12]}… (shard from another run; delete it or use another --out)")
+    seed = shard_seed(plan.master_seed, index)
+    place = {"format": SHARD_FORMAT, "shard": index, "first_sample": index * plan.shard_size,
+             "n_samples": expected_count, "seed": {"master_seed": plan.master_seed, "spawn_key": list(seed.spawn_key)}}
+    for key, want in place.items():
+        if sidecar.get(key) != want:
+            raise HostError(f"{json_path}: {key} is {str(sidecar.get(key))[:40]}, shard {index} of this dataset has "
+                            f"{want} (a copied or edited sidecar); delete it and its npz to recompute the shard")
     try:
         data = npz_path.read_bytes()
     except OSError:
@@ -231,6 +242,12 @@ def read_shard(directory: Path, index: int, config_hash: str, expected_count: in
     arrays = _load_npz(npz_path, data)
     if arrays["s_in"].shape[0] != expected_count:
         raise HostError(f"{npz_path}: {arrays['s_in'].shape[0]} samples, the dataset expects {expected_count}")
+    if not np.array_equal(arrays["s_in"], draw_inputs(plan.master_seed, index, expected_count)):
+        raise HostError(f"{npz_path}: its inputs are not the ones shard {index}'s seed draws (a swapped or edited "
+                        f"shard); delete {npz_path.name} and {json_path.name} to recompute it")
+    if sidecar.get("statistics") != shard_statistics(arrays):
+        raise HostError(f"{json_path}: statistics differ from the ones its npz gives (an edited sidecar); "
+                        f"delete it and its npz to recompute the shard")
     return arrays, sidecar
 
 
@@ -313,7 +330,7 @@ def load_dataset(directory, include_failed: bool = False):
     if missing:
         raise HostError(f"{directory}: dataset incomplete, {len(missing)} of {plan.n_shards} shards missing "
                         f"(first: shard-{missing[0]:05d}); rerun `staregen samples` with the same arguments")
-    parts = [read_shard(directory, i, plan.config_hash(), plan.shard_count(i))[0] for i in range(plan.n_shards)]
+    parts = [read_shard(directory, plan, i)[0] for i in range(plan.n_shards)]
     X = np.concatenate([p["s_in"] for p in parts])
     Y = np.concatenate([p["command"] for p in parts])
     status = np.concatenate([p["status"] for p in parts])
@@ -367,7 +384,7 @@ def finished_shards(directory: Path, plan: DatasetPlan) -> list[int]:
     done = []
     for index in range(plan.n_shards):
         if shard_is_finished(directory, index):
-            read_shard(directory, index, plan.config_hash(), plan.shard_count(index))
+            read_shard(directory, plan, index)
             done.append(index)
     return done
 

@@ -134,6 +134,32 @@ def test_corrupt_truncated_foreign_or_missing_shards_are_one_line_errors(tmp_pat
     assert "incomplete" in _one_line_error(excinfo)
 
 
+def test_swapped_or_edited_shards_are_refused(tmp_path):
+    """Issue 14 defect 5: shard 1 copied over shard 0 (npz + sidecar), or a sidecar's index, first
+    sample, seed or statistics edited, is refused: each shard is bound to its place and content."""
+    plan = DatasetPlan(6, OcpConfig(), shard_size=2)
+    _fake_dataset(tmp_path, plan)
+    load_dataset(tmp_path)
+    (npz0, json0), (npz1, json1) = shard_paths(tmp_path, 0), shard_paths(tmp_path, 1)
+    saved = npz0.read_bytes(), json0.read_text()
+    npz0.write_bytes(npz1.read_bytes())
+    json0.write_text(json1.read_text())
+    with pytest.raises(HostError) as excinfo:
+        load_dataset(tmp_path)
+    assert "shard" in _one_line_error(excinfo)
+    npz0.write_bytes(saved[0])
+    sidecar = json.loads(saved[1])
+    edits = [("shard", 1), ("first_sample", 2), ("n_samples", 3), ("seed", {"master_seed": 1, "spawn_key": [0]}),
+             ("statistics", {**sidecar["statistics"], "iterations_max": 999})]
+    for key, value in edits:
+        json0.write_text(json.dumps({**sidecar, key: value}))
+        with pytest.raises(HostError) as excinfo:
+            load_dataset(tmp_path)
+        assert key in _one_line_error(excinfo), key
+    json0.write_text(saved[1])
+    load_dataset(tmp_path)
+
+
 def test_a_directory_of_another_configuration_is_refused(tmp_path):
     open_dataset_dir(tmp_path, DatasetPlan(6, OcpConfig(), shard_size=2))
     with pytest.raises(HostError) as excinfo:
