@@ -30,6 +30,7 @@ COMMANDS = [
     "host.cli.package",
     "host.cli.c_eval",
     "host.cli.verify",
+    "host.cli.fuzz",
     "host.cli.cycles",
     "host.cli.impulse",
     "host.cli.tanh",
