@@ -31,6 +31,7 @@ COMMANDS = [
     "host.cli.c_eval",
     "host.cli.verify",
     "host.cli.fuzz",
+    "host.cli.coverage",
     "host.cli.cycles",
     "host.cli.impulse",
     "host.cli.tanh",

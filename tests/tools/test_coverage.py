@@ -1,0 +1,39 @@
+"""`staregen coverage`: gcov counts of a unit's C under its gate vectors; a planted unreachable
+branch is reported at its line, an always-taken one is not."""
+from __future__ import annotations
+
+from codegen.artifact import random_artifact
+from codegen.units.network.unit import NetworkUnit
+from host.cli import main
+from tools.coverage import measure, report_lines
+
+ARTIFACT = random_artifact((6, 8, 2), seed=5)
+
+
+class Planted(NetworkUnit):
+    def sources(self):
+        files = dict(super().sources())
+        files["network.c"] = files["network.c"].replace(
+            "    y[1] = ", "    if (yn1 > 0x1p+120f) {   /* PLANTED: never true */\n        y[0] = 0.0f;\n    }\n"
+            "    y[1] = ", 1)
+        return files
+
+
+def test_network_lines_all_run_and_a_planted_branch_is_untaken():
+    clean = measure(NetworkUnit(ARTIFACT), n=2_000)
+    net = clean.files["network.c"]
+    assert net.lines_hit == net.lines and net.untaken == []
+    planted = Planted(ARTIFACT)
+    rep = measure(planted, n=2_000)
+    text = planted.sources()["network.c"].splitlines()
+    untaken = [ln for ln, _ in rep.files["network.c"].untaken]
+    assert untaken and all("PLANTED" in text[ln - 1] for ln in untaken)
+    lines = report_lines(rep, planted.sources())
+    assert any("PLANTED" in ln and "network.c:" in ln for ln in lines)
+    assert rep.vectors == 2_000
+
+
+def test_cli_writes_the_report(tmp_path, capsys):
+    assert main(["coverage", "--unit", "tanh", "--vectors", "1000", "--md", str(tmp_path / "c.md")]) == 0
+    text = (tmp_path / "c.md").read_text()
+    assert "### Unit `tanh`" in text and "| `tanh.c` |" in text
