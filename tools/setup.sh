@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Idempotent set-up for a fresh Debian machine: the ARM toolchain and cmake from Debian, then the
+# Idempotent set-up for a fresh Debian machine: the ARM toolchain, cmake and cppcheck from Debian, then the
 # Python package (torch pinned to the CPU wheel first so nothing pulls CUDA builds).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,11 +14,12 @@ if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 \
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq gcc-arm-none-eabi libnewlib-arm-none-eabi >/dev/null
 fi
 
-# cmake builds the flight package with its own CMakeLists (staregen generate, package check, tests).
-if ! command -v cmake >/dev/null 2>&1; then
-  echo "setup: installing cmake (apt)"
+# cmake builds the flight package with its own CMakeLists (staregen generate, package check, tests);
+# cppcheck with its MISRA addon checks the generated C (staregen misra).
+if ! command -v cmake >/dev/null 2>&1 || ! command -v cppcheck >/dev/null 2>&1; then
+  echo "setup: installing cmake and cppcheck (apt)"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck >/dev/null
 fi
 
 stamp=.setup-stamp

@@ -32,6 +32,7 @@ COMMANDS = [
     "host.cli.verify",
     "host.cli.fuzz",
     "host.cli.coverage",
+    "host.cli.misra",
     "host.cli.cycles",
     "host.cli.impulse",
     "host.cli.tanh",
