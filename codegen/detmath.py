@@ -86,6 +86,7 @@ def _load_tanh_table() -> np.ndarray:
 
 
 _TANH_TAB = _load_tanh_table()
+TANH_TABLE = _TANH_TAB   # sg_tanh_tab as laid out in flash (the integrity CRC covers it)
 _TANH_COLS = tuple(np.ascontiguousarray(_TANH_TAB[:, j]) for j in range(6))  # fast 1-D take
 
 

@@ -592,3 +592,17 @@ float sg_powf_pos(float x, float y)
     }
     return sg_expf(y * sg_logf(x));
 }
+
+uint32_t sg_crc32(const void *data, uint32_t bytes, uint32_t crc)
+{
+    const unsigned char *p = (const unsigned char *)data;
+    uint32_t i, k;
+    crc = ~crc;
+    for (i = 0u; i < bytes; ++i) {
+        crc ^= (uint32_t)p[i];
+        for (k = 0u; k < 8u; ++k) {
+            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+        }
+    }
+    return ~crc;
+}

@@ -22,7 +22,10 @@ class Planted(NetworkUnit):
 def test_network_lines_all_run_and_a_planted_branch_is_untaken():
     clean = measure(NetworkUnit(ARTIFACT), n=2_000)
     net = clean.files["network.c"]
-    assert net.lines_hit == net.lines and net.untaken == []
+    # every line runs but network_tables_crc32's (the integrity check: nothing in a step calls it)
+    text = NetworkUnit(ARTIFACT).sources()["network.c"]
+    crc_body = text[text.index("network_tables_crc32(void)\n{"):].split("\n}\n")[0].count("\n") + 1
+    assert 0 < net.lines - net.lines_hit <= crc_body and net.untaken == []
     planted = Planted(ARTIFACT)
     rep = measure(planted, n=2_000)
     text = planted.sources()["network.c"].splitlines()

@@ -24,7 +24,7 @@ DEFAULT_NAME = "controller"
 INPUT_DTYPE = np.dtype([("A_bo", "<f4", 3), ("omega_b", "<f4", 3), ("R_s", "<f4", 3), ("V_s", "<f4", 3),
                         ("lon", "<i4"), ("lat", "<i4"), ("utc_day", "<i4"), ("utc_ms", "<i4")])
 OUTPUT_DTYPE = np.dtype([("torque", "<f4", 3), ("status", "<u4"), ("A_bd", "<f4", 3), ("omega_e", "<f4", 3)])
-STATE_DTYPE = np.dtype([("integral", "<f4", 3), ("mode", "<u4"), ("clean", "<u4")])
+STATE_DTYPE = np.dtype([("integral", "<f4", 3), ("mode", "<u4"), ("clean", "<u4"), ("fault", "<u4")])
 # The state_in_record adapter: { state; input } -> { output; state }.
 RECORD_IN_DTYPE = np.dtype([("state", STATE_DTYPE), ("input", INPUT_DTYPE)])
 RECORD_OUT_DTYPE = np.dtype([("output", OUTPUT_DTYPE), ("state", STATE_DTYPE)])
@@ -61,12 +61,12 @@ def controller_context(a: Artifact, cfg: cs.ControllerConfig, name: str) -> dict
     f = c_float
     env_min, env_max = envelope_bounds(a, cfg)
     return {
-        "name": name, "P": name.upper(), "net": net_name(name), "n_in": a.n_in,
+        "name": name, "P": name.upper(), "net": net_name(name), "NET": net_name(name).upper(), "n_in": a.n_in,
         "generator_version": GENERATOR_VERSION, "sha256": a.sha256,
         "creator": comment(a.metadata.get("creator", "")),
         "status_pid": cs.STATUS_PID, "status_bounds_mask": cs.STATUS_BOUNDS_MASK,
         "status_invalid": cs.STATUS_INPUT_INVALID, "status_saturated": cs.STATUS_SATURATED,
-        "status_dwell": cs.STATUS_DWELL, "lat_bam_max": cs.LAT_BAM_MAX, "status_state_repaired": cs.STATUS_STATE_REPAIRED,
+        "status_dwell": cs.STATUS_DWELL, "status_integrity": cs.STATUS_INTEGRITY, "lat_bam_max": cs.LAT_BAM_MAX, "status_state_repaired": cs.STATUS_STATE_REPAIRED,
         "status_bound_shift": cs.STATUS_BOUND_SHIFT,
         "utc_ms_max": cs.UTC_MS_MAX, "utc_day_min": cs.UTC_DAY_MIN, "utc_day_max": cs.UTC_DAY_MAX,
         "gmst_a": _c_u64(cs.GMST_A), "gmst_b": _c_u64(cs.GMST_B), "gmst_q": _c_u64(cs.GMST_Q),

@@ -229,6 +229,7 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     for i in range(x.shape[1]):
         status |= np.where(inside[:, i], U32(0), U32(1 << (cs.STATUS_BOUND_SHIFT + i)))
     status |= np.where(valid, U32(0), U32(cs.STATUS_INPUT_INVALID))
+    status |= np.where(state["fault"] != 0, U32(cs.STATUS_INTEGRITY), U32(0))   # tables corrupted: PID only
     integral, repaired = repair_integral(cfg, state["integral"])
     raw, integral = pid(cfg, integral, x, geometry_ok)
     mode, count = update_mode(cfg, state["mode"], state["clean"], status == 0)
@@ -245,6 +246,6 @@ def _step(a: Artifact, cfg: cs.ControllerConfig, state: np.ndarray, inp: np.ndar
     # fails comparisons and is zeroed by the PID, so its bits matter nowhere else)
     out["A_bd"], out["omega_e"] = dm.canonf(out["A_bd"]), dm.canonf(out["omega_e"])
     new = np.zeros(inp.shape, dtype=STATE_DTYPE)
-    new["integral"], new["mode"], new["clean"] = integral, mode, count
+    new["integral"], new["mode"], new["clean"], new["fault"] = integral, mode, count, state["fault"]
     return out, new
 

@@ -82,6 +82,9 @@ def field_docs(cfg: cs.ControllerConfig) -> dict[str, list[FieldDoc]]:
                      f"0..{dwell} (timing.dwell_steps); a larger value from the caller: the network resumes at "
                      "the next clean step", f"consecutive clean steps while the PID flies; the network resumes "
                      f"after {dwell} ({dwell * cfg.control_period:.6g} s)"),
+            FieldDoc("fault", "-", "-", "0: tables intact; set by init / integrity_check when the network's "
+                     "constant tables fail their CRC-32, then only the PID flies (STATUS_INTEGRITY) until init",
+                     "integrity of the network's constant tables"),
         ],
     }
 
@@ -104,5 +107,8 @@ def status_bits() -> list[StatusBit]:
         StatusBit("STATUS_STATE_REPAIRED", cs.STATUS_STATE_REPAIRED,
                   "the caller's state held a non-finite or out-of-limit integrator, reset to 0; caller: the "
                   "state's memory was corrupted (bit flip, overwrite): FDIR event"),
+        StatusBit("STATUS_INTEGRITY", cs.STATUS_INTEGRITY,
+                  "the network's constant tables failed their CRC-32 (init or integrity_check): only the PID "
+                  "flies until init finds them intact; caller: FDIR event, reload or re-flash the image"),
     ]
 

@@ -18,6 +18,7 @@ STATUS_INPUT_INVALID = 1 << 13   # a non-finite input field, or UTC day / ms out
 STATUS_SATURATED = 1 << 14       # at least one torque axis clipped to the wheel limit
 STATUS_DWELL = 1 << 15           # inside the envelope, PID still flying until the dwell ends
 STATUS_STATE_REPAIRED = 1 << 16  # the caller's state held a non-finite or out-of-limit integrator: reset to 0
+STATUS_INTEGRITY = 1 << 17       # the network's constant tables failed their CRC-32 (at init or a check): PID only
 STATUS_BOUNDS_MASK = ((1 << N_BOUNDS) - 1) << STATUS_BOUND_SHIFT
 
 MODE_NN, MODE_PID = 0, 1

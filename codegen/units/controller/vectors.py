@@ -55,6 +55,7 @@ class FlightScenario(Protocol):
 
 CORRUPT_INTEGRALS = np.array([np.nan, np.inf, -np.inf, 3.4028235e38, -1e6, 1e6], dtype=np.float32)
 CORRUPT_SHARE = 0.02
+FAULT_SHARE = 0.02     # states whose integrity check failed (the step must fly the PID)
 SPECIAL_F32 = np.array([np.nan, -np.nan, np.inf, -np.inf, np.finfo(np.float32).max, -np.finfo(np.float32).max,
                         0.0, -0.0, 1e-45, -1e-45, 1.1754942e-38], dtype=np.float32)
 FLOAT_FIELDS = ("A_bo", "omega_b", "R_s", "V_s")
@@ -70,6 +71,7 @@ def random_states(rng: np.random.Generator, n: int, dwell: int) -> np.ndarray:
     st["clean"] = rng.integers(0, dwell + 1, n)
     bad = np.flatnonzero(rng.random(n) < CORRUPT_SHARE)
     st["integral"][bad, rng.integers(0, 3, bad.size)] = rng.choice(CORRUPT_INTEGRALS, bad.size)
+    st["fault"] = np.where(rng.random(n) < FAULT_SHARE, rng.choice([1, 0xFFFFFFFF], n), 0)   # a failed CRC
     return st
 
 

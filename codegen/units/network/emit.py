@@ -6,9 +6,12 @@ timestamps, no paths, no dict-order dependence, so the same artifact gives byte-
 from __future__ import annotations
 
 import os
+import zlib
 from pathlib import Path
 
-from codegen import GENERATOR_VERSION
+import numpy as np
+
+from codegen import GENERATOR_VERSION, detmath
 from codegen.artifact import Artifact
 from codegen.cgen import c_float, check_name, comment, environment, math_sources, write_sources
 
@@ -55,6 +58,17 @@ def load_groups(n_in: int) -> list[list[int]]:
     return [order[k:k + LOAD_GROUP] for k in range(0, len(order), LOAD_GROUP)]
 
 
+def tables_crc32(a: Artifact) -> int:
+    """zlib's CRC-32 of the network's constant tables in the C's order and layout (little-endian
+    float32), then sg_math's tanh table: what <name>_tables_crc32() computes on the target."""
+    neurons = np.concatenate([a.b1[:, None], a.W1, a.W2.T], axis=1)
+    crc = 0
+    for table in (neurons, a.b2, a.input_map.xoffset, a.input_map.gain, a.output_map.xoffset, a.output_map.gain,
+                  detmath.TANH_TABLE):
+        crc = zlib.crc32(np.ascontiguousarray(table, dtype="<f4").tobytes(), crc)
+    return crc
+
+
 def template_context(a: Artifact, name: str) -> dict:
     env, out = a.envelope, a.outputs
     return {
@@ -68,6 +82,7 @@ def template_context(a: Artifact, name: str) -> dict:
         "inputs": _labels(env.names, env.units, env.descriptions, env.min, env.max),
         "outputs": _labels(out.names, out.units, out.descriptions),
         "neurons": _neurons(a),
+        "tables_crc32": f"0x{tables_crc32(a):08x}",
         "b2": [c_float(v) for v in a.b2],
         "in_xoffset": [c_float(v) for v in a.input_map.xoffset],
         "in_gain": [c_float(v) for v in a.input_map.gain],

@@ -162,7 +162,8 @@ def test_status_masks_are_the_spec_constants():
     ctrl = {b.name: b.mask for b in example_unit(units.get("controller")).status_bits()}
     assert ctrl == {"STATUS_PID": cs.STATUS_PID, "STATUS_BOUNDS_MASK": cs.STATUS_BOUNDS_MASK,
                     "STATUS_INPUT_INVALID": cs.STATUS_INPUT_INVALID, "STATUS_SATURATED": cs.STATUS_SATURATED,
-                    "STATUS_DWELL": cs.STATUS_DWELL, "STATUS_STATE_REPAIRED": cs.STATUS_STATE_REPAIRED}
+                    "STATUS_DWELL": cs.STATUS_DWELL, "STATUS_STATE_REPAIRED": cs.STATUS_STATE_REPAIRED,
+                    "STATUS_INTEGRITY": cs.STATUS_INTEGRITY}
     assert ctrl["STATUS_BOUNDS_MASK"] == sum(1 << (cs.STATUS_BOUND_SHIFT + i) for i in range(cs.N_BOUNDS))
     tanh = {b.name: b.mask for b in example_unit(units.get("tanh")).status_bits()}
     assert tanh == {"STATUS_SINGULAR": tanh_golden.STATUS_SINGULAR,
@@ -294,7 +295,7 @@ def test_undocumented_unit_is_listed_and_said_so():
     table = section(unit_section(text, "controller"), "### `stare_state_t` (state)")
     assert "Not documented by the unit" in table
     rows = [split_row(ln) for ln in table.splitlines() if ln.startswith("| `")]
-    assert [r[0] for r in rows] == ["`integral`", "`mode`", "`clean`"]
+    assert [r[0] for r in rows] == ["`integral`", "`mode`", "`clean`", "`fault`"]
     assert all(r[5] == "not documented by the unit" for r in rows)
 
 

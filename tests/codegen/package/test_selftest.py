@@ -110,7 +110,7 @@ def test_contraction_is_caught_in_the_selftest_unit(tmp_path, package_sources):
 
 def test_layout_helpers():
     from codegen.units.controller.emit import STATE_DTYPE
-    assert field_elements(STATE_DTYPE) == ["integral[0]", "integral[1]", "integral[2]", "mode", "clean"]
+    assert field_elements(STATE_DTYPE) == ["integral[0]", "integral[1]", "integral[2]", "mode", "clean", "fault"]
 
 
 def test_bad_requests(units):

@@ -225,7 +225,7 @@ def test_arm_image_has_no_soft_double_and_no_libm(unit):
 
 def test_record_dtypes_are_the_c_structs(unit):
     """Sizes as documented; the cffi wrapper and the ARM adapters refuse to build otherwise."""
-    assert (INPUT_DTYPE.itemsize, OUTPUT_DTYPE.itemsize, STATE_DTYPE.itemsize) == (64, 40, 20)
+    assert (INPUT_DTYPE.itemsize, OUTPUT_DTYPE.itemsize, STATE_DTYPE.itemsize) == (64, 40, 24)
     checks = layout_checks(unit)
     assert "sizeof(controller_input_t) == 64u" in checks and "offsetof(controller_output_t, status) == 12u" in checks
     assert "offsetof(controller_input_t, lon) == 48u" in checks and "offsetof(controller_state_t, clean) == 16u" in checks
