@@ -54,3 +54,21 @@ def unit_from_args(args: argparse.Namespace) -> Unit:
         print("unit controller: no --artifact, using the stand-in network fitted to the PID law")
         inputs["artifact"] = load_artifact(None)
     return configure_unit(args.unit, **inputs)
+
+
+def add_report_unit_arguments(parser: argparse.ArgumentParser) -> None:
+    """--unit U|all with the default inputs of a report over units (coverage, MISRA)."""
+    parser.add_argument("--unit", default="all", choices=[*sorted(units.kinds()), "all"], help="unit (default all)")
+    parser.add_argument("--artifact", metavar="FILE", help="network artifact (default: the stand-in network)")
+    parser.add_argument("--params", metavar="FILE", default="docs/tanh_paper000.toml",
+                        help="tanh parameters (default docs/tanh_paper000.toml)")
+
+
+def report_units(args: argparse.Namespace) -> list[Unit]:
+    """The units of --unit (all registered ones for `all`) bound to --artifact / --params, the
+    others to their examples."""
+    network = art.load(args.artifact) if args.artifact else load_artifact(None)
+    inputs = {"network": {"artifact": network}, "controller": {"artifact": network},
+              "tanh": {"params": load_params(args.params)}}
+    kinds = sorted(units.kinds()) if args.unit == "all" else [args.unit]
+    return [configure_unit(kind, **inputs.get(kind, units.get(kind).example())) for kind in kinds]
