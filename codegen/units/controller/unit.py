@@ -54,7 +54,8 @@ class ControllerUnit(Unit):
         return self.scenario
 
     def gate_classes(self, n: int, seed: int) -> dict[str, Batch]:
-        return vectors.gate_classes(self._scenario(), n, seed, self.config.dwell_steps)
+        cfg = self.config
+        return vectors.gate_classes(self._scenario(), n, seed, cfg.dwell_steps, cfg.integral_limit)
 
     def gate_sequences(self, n_seq: int, steps: int, seed: int) -> np.ndarray:
         return vectors.sequences(self._scenario(), n_seq, steps, seed)

@@ -55,7 +55,8 @@ class FlightScenario(Protocol):
 
 CORRUPT_INTEGRALS = np.array([np.nan, np.inf, -np.inf, 3.4028235e38, -1e6, 1e6], dtype=np.float32)
 CORRUPT_SHARE = 0.02
-FAULT_SHARE = 0.02     # states whose integrity check failed (the step must fly the PID)
+FAULT_SHARE = 0.02
+NEAR_LIMIT_SHARE = 0.05   # integrators within 0.004 deg*s of the limit (the clamp runs)     # states whose integrity check failed (the step must fly the PID)
 SPECIAL_F32 = np.array([np.nan, -np.nan, np.inf, -np.inf, np.finfo(np.float32).max, -np.finfo(np.float32).max,
                         0.0, -0.0, 1e-45, -1e-45, 1.1754942e-38], dtype=np.float32)
 FLOAT_FIELDS = ("A_bo", "omega_b", "R_s", "V_s")
@@ -126,8 +127,11 @@ def bit_inputs(rng, n):
     return raw.view(INPUT_DTYPE).reshape(n).copy()
 
 
-def gate_classes(sc: FlightScenario, n: int, seed: int, dwell: int) -> dict[str, Batch]:
-    """n independent steps (deterministic in seed), in class order."""
+def gate_classes(sc: FlightScenario, n: int, seed: int, dwell: int, integral_limit: float | None = None
+                 ) -> dict[str, Batch]:
+    """n independent steps (deterministic in seed), in class order. With `integral_limit`, a share
+    of the states hold an integrator just inside its limit, so that a step's error pushes it over
+    (the anti-windup clamp runs)."""
     rng = np.random.default_rng(seed)
     counts = {k: int(n * SHARES.get(k, 0.0)) for k in KINDS}
     counts["inside"] = n - sum(counts.values())
@@ -135,6 +139,10 @@ def gate_classes(sc: FlightScenario, n: int, seed: int, dwell: int) -> dict[str,
               "invalid": lambda m: invalid_inputs(sc, rng, m), "bits": lambda m: bit_inputs(rng, m)}
     inputs = {k: makers[k](counts[k]) for k in KINDS if counts[k] > 0}
     states = random_states(rng, n, dwell)
+    if integral_limit is not None:
+        near = np.flatnonzero(rng.random(n) < NEAR_LIMIT_SHARE)
+        side = rng.choice([-1.0, 1.0], (near.size, 3))
+        states["integral"][near] = side * (integral_limit - rng.uniform(0.0, 0.004, (near.size, 3)))
     out, start = {}, 0
     for k, inp in inputs.items():
         out[k] = Batch(states[start:start + inp.shape[0]].copy(), inp)
