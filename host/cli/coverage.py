@@ -1,6 +1,6 @@
 """`staregen coverage [--unit U | --unit all] [--vectors N] [--md FILE]`: gcov line and branch
 coverage of each unit's generated C under its gate vectors, every untaken branch listed with its
-source line (the material of docs/coverage.md)."""
+source line (docs/coverage-report.md; the triage is docs/coverage.md)."""
 from __future__ import annotations
 
 import argparse
@@ -17,7 +17,7 @@ def register(subparsers) -> None:
     add_report_unit_arguments(parser)
     parser.add_argument("--vectors", default="20000", help="gate vectors per unit (default 20000)")
     parser.add_argument("--seed", default="0", help="vector seed (default 0)")
-    parser.add_argument("--md", metavar="FILE", help="write the report as Markdown")
+    parser.add_argument("--md", metavar="FILE", help="write the report as Markdown (docs/coverage-report.md)")
     parser.set_defaults(func=run)
 
 
