@@ -268,7 +268,7 @@ static float sg_exp_outer(float x)
  */
 float sg_expf(float x)
 {
-    if (__builtin_expect(!(__builtin_fabsf(x) <= 87.0f), 0)) {
+    if (__builtin_expect(!(__builtin_fabsf(x) <= 87.0f), 0) != 0) {
         return sg_exp_outer(x);
     }
     float t = x * SG_INV_LN2 + SG_MAGIC;
@@ -296,7 +296,7 @@ float sg_logf(float x)
         if (x != x || ix == 0x7f800000u) {
             return x + x;
         }
-        if (ix >> 31) {
+        if ((ix >> 31) != 0u) {
             return sg_nan();
         }
         ix = sg_as_u32(x * 0x1p23f);
@@ -361,7 +361,7 @@ static float sg_trig(float x, uint32_t shift)
     float w = jf * SG_PIO2_3;
     float hi = t2 - w;
     float lo = ((t2 - hi) - w) - jf * SG_PIO2_4;
-    if (__builtin_expect(!(__builtin_fabsf(x) <= SG_TRIG_MAX_ARG), 0)) {
+    if (__builtin_expect(!(__builtin_fabsf(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
         hi = hi > SG_PIO4 ? SG_PIO4 : (hi < -SG_PIO4 ? -SG_PIO4 : hi);
         lo = 0.0f;
     }
@@ -410,7 +410,7 @@ static float sg_asin_tail(float x, float z)
 float sg_asinf(float x)
 {
     float a = __builtin_fabsf(x);
-    if (__builtin_expect(!(a <= 1.0f), 0)) {
+    if (__builtin_expect(!(a <= 1.0f), 0) != 0) {
         return x != x ? x + x : sg_nan();
     }
     if (a < 0.5f) {
@@ -476,7 +476,7 @@ float sg_atan2f(float y, float x)
     int swap = a > b;
     float k = sg_atan_kernel((swap ? b : a) / (swap ? a : b));
     float t = swap ? SG_PIO2_HI + (SG_PIO2_LO - k) : k;
-    if (xneg) {
+    if (xneg != 0u) {
         t = SG_PI_HI + (SG_PI_LO - t);
     }
     return (sg_as_u32(y) >> 31) ? -t : t;

@@ -113,7 +113,7 @@ static inline float sg_inline_tanhf(float x)
     uint32_t i;
     b.f = x;
     i = sg_tanh_index(b.u);
-    if (__builtin_expect(i >= SG_TANH_N, 0)) {
+    if (__builtin_expect(i >= SG_TANH_N, 0) != 0) {
         return sg_tanhf(x);
     }
     return sg_tanh_poly(sg_tanh_tab[i], x, b.u);
@@ -220,7 +220,7 @@ static SG_ALWAYS_INLINE float sg_powf_fused(float x, float y)
     t = th + tl;
     /* |y| <= 31/32 implies |t| <= 124 for every normal x: with such a constant y (the tanh law's)
      * the compiler drops the test on t; the fast-path set is the same either way. */
-    if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < SG_POWF_FUSED_MAX_T), 0)) {
+    if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < SG_POWF_FUSED_MAX_T), 0) != 0) {
         return sg_powf_pos(x, y);
     }
     bt.f = t + 0x1.8p+23f;
