@@ -83,30 +83,36 @@ def build(unit: Unit, folder: Path) -> Path:
     objects = []
     for name in sorted(n for n in files if n.endswith(".c")):   # one object each: <name>.gcno / .gcda
         obj = folder / (name[:-2] + ".o")
-        _compile(["gcc", *with_opt(COMMON, "-O0"), *COVERAGE_FLAGS, "-I", str(folder), "-c", name, "-o", obj.name],
+        compile_in(["gcc", *with_opt(COMMON, "-O0"), *COVERAGE_FLAGS, "-I", str(folder), "-c", name, "-o", obj.name],
                  folder)
         objects.append(obj.name)
-    _compile(["gcc", *COVERAGE_FLAGS, *objects, "-o", exe.name], folder)
+    compile_in(["gcc", *COVERAGE_FLAGS, *objects, "-o", exe.name], folder)
     return exe
 
 
-def _compile(cmd: list[str], folder: Path) -> None:
+def compile_in(cmd: list[str], folder: Path) -> None:
     res = subprocess.run(cmd, capture_output=True, text=True, cwd=folder)
     if res.returncode != 0:
         first = next((ln for ln in res.stderr.splitlines() if "error" in ln), res.stderr.strip()[:200])
         raise ToolError(f"coverage: build failed: {first}")
 
 
-def _run(exe: Path, data: bytes, *args: str) -> None:
+def _run(exe: Path, data: bytes, *args: str) -> bytes:
     res = subprocess.run([str(exe), *args], input=data, capture_output=True, cwd=exe.parent, timeout=3600)
     if res.returncode != 0:
         raise ToolError(f"coverage: the instrumented build exited with {res.returncode}")
+    return res.stdout
+
+
+def run_words(exe: Path, data: bytes) -> np.ndarray:
+    """The instrumented build's stdout as 32-bit words."""
+    return np.frombuffer(_run(exe, data), dtype=np.uint32)
 
 
 LIBRARY = ("sg_math.c", "sg_math.h")   # shared: only the functions the unit runs count
 
 
-def _gcov(folder: Path, objects: list[str], files: list[str]) -> tuple[dict[str, FileCoverage], list[str]]:
+def gcov_counts(folder: Path, objects: list[str], files: list[str]) -> tuple[dict[str, FileCoverage], list[str]]:
     """Line and branch counts of `files`, summed over every object (a header's inline code appears in
     each object that includes it); in the shared library, functions never run are left out and
     returned by name."""
@@ -174,7 +180,7 @@ def measure(unit: Unit, n: int = 20_000, n_seq: int = 4, steps: int = 500, seed:
                 _run(exe, np.ascontiguousarray(seqs[s]).tobytes(), "seq")
                 total += seqs.shape[1]
         objects = sorted(name[:-2] + ".o" for name in unit.sources() if name.endswith(".c"))
-        files, unused = _gcov(folder, objects, sorted(unit.sources()))
+        files, unused = gcov_counts(folder, objects, sorted(unit.sources()))
         return CoverageReport(unit.kind, total, files, unused)
 
 

@@ -9,6 +9,7 @@ from codegen import atomic
 from host.cli.args import parse_int
 from host.cli.units import add_report_unit_arguments, report_units
 from tools.coverage import measure, report_lines
+from tools.coverage_library import library_lines, measure_library
 
 
 def register(subparsers) -> None:
@@ -27,8 +28,13 @@ def run(args: argparse.Namespace) -> int:
     lines = ["# Structural coverage of the generated C (`staregen coverage`)", ""]
     for unit in report_units(args):
         lines += report_lines(measure(unit, n, seed=seed), unit.sources()) + [""]
+    mismatches = 0
+    if args.unit == "all":
+        lib = measure_library(n, seed=seed)
+        mismatches = sum(lib.mismatches.values())
+        lines += library_lines(lib) + [""]
     text = "\n".join(lines)
     print(text)
     if args.md:
         atomic.write_text(args.md, text + "\n")
-    return 0
+    return 0 if mismatches == 0 else 1

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from pathlib import Path
 
 from codegen import artifact as art
 from codegen import units
@@ -14,6 +15,10 @@ from host.cli.args import parse_number
 from host.errors import HostError
 from host.control.nn_controller import load_artifact
 from host.sim.scenarios import configure_unit
+
+
+# the paper-000 example's parameters, found from any working directory
+PAPER000_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "tanh_paper000.toml"
 
 
 def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network") -> None:
@@ -60,8 +65,8 @@ def add_report_unit_arguments(parser: argparse.ArgumentParser) -> None:
     """--unit U|all with the default inputs of a report over units (coverage, MISRA)."""
     parser.add_argument("--unit", default="all", choices=[*sorted(units.kinds()), "all"], help="unit (default all)")
     parser.add_argument("--artifact", metavar="FILE", help="network artifact (default: the stand-in network)")
-    parser.add_argument("--params", metavar="FILE", default="docs/tanh_paper000.toml",
-                        help="tanh parameters (default docs/tanh_paper000.toml)")
+    parser.add_argument("--params", metavar="FILE", default=str(PAPER000_PARAMS),
+                        help="tanh parameters (default the paper-000 example, docs/tanh_paper000.toml)")
 
 
 def report_units(args: argparse.Namespace) -> list[Unit]:

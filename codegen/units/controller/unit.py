@@ -55,7 +55,7 @@ class ControllerUnit(Unit):
 
     def gate_classes(self, n: int, seed: int) -> dict[str, Batch]:
         cfg = self.config
-        return vectors.gate_classes(self._scenario(), n, seed, cfg.dwell_steps, cfg.integral_limit)
+        return vectors.gate_classes(self._scenario(), n, seed, cfg.dwell_steps, cfg.integral_limit, cfg)
 
     def gate_sequences(self, n_seq: int, steps: int, seed: int) -> np.ndarray:
         return vectors.sequences(self._scenario(), n_seq, steps, seed)

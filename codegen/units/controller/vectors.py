@@ -5,6 +5,8 @@ Realistic inputs need the orbit, the Earth and the staring guidance, which live 
 it) turns geometry samples and chosen errors in S_d into sensor readings. The classes:
   inside    errors uniform inside Table 2, random controller states (either mode, any dwell count);
   bound     one of A_bd / ω_e at a bound ×(1 ± 1e-3), or a target far off-track (ω_d bounds);
+            an eighth with the body y axis along ± the desired z axis (a 90° roll error: the
+            asin argument rounds beyond ±1 in about a sixth of them and its clamp runs);
   invalid   one field (or all) of the input set to NaN, ±Inf, ±FLT_MAX, ±0, subnormals; UTC
             day or ms out of range;
   bits      every field a random bit pattern.
@@ -20,6 +22,8 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from codegen.unit import Batch
+from codegen.golden_vec3 import v_dot
+from codegen.units.controller import golden as cg
 from codegen.units.controller import spec as cs
 from codegen.units.controller.emit import INPUT_DTYPE, STATE_DTYPE
 
@@ -101,6 +105,18 @@ def bound_inputs(sc: FlightScenario, rng, n):
     return np.concatenate([sc.inputs(g_near, A[:half], w[:half]), sc.inputs(g_far, A[half:], w[half:])])
 
 
+def parallel_axis_attitudes(cfg: cs.ControllerConfig, inp: np.ndarray, rng) -> np.ndarray:
+    """A_bo (rad, float32) putting the body y axis along ± the desired z axis of each row: the
+    controller's s = b1 . c2 (the sine of the roll error) is then ±1 up to rounding."""
+    R = tuple(np.ascontiguousarray(inp["R_s"][:, i]) for i in range(3))
+    V = tuple(np.ascontiguousarray(inp["V_s"][:, i]) for i in range(3))
+    d = cg.desired(cfg, R, V, cg.target(cfg, inp["lon"], inp["lat"], cg.gmst_turns(inp["utc_day"], inp["utc_ms"])))
+    c2 = np.stack([v_dot(d["xo"], d["z"]), -v_dot(d["n"], d["z"]), -v_dot(d["rh"], d["z"])], -1).astype(np.float64)
+    c2 *= rng.choice([-1.0, 1.0], (inp.shape[0], 1)) / np.linalg.norm(c2, axis=1, keepdims=True)
+    roll, yaw = np.arcsin(np.clip(c2[:, 2], -1.0, 1.0)), np.arctan2(-c2[:, 0], c2[:, 1])
+    return np.stack([roll, rng.uniform(-np.pi, np.pi, inp.shape[0]), yaw], -1).astype(np.float32)
+
+
 def invalid_inputs(sc: FlightScenario, rng, n):
     """Special values in each float field in turn, UTC out of range, extreme binary angles."""
     A, w = uniform_errors(rng, n)
@@ -127,17 +143,21 @@ def bit_inputs(rng, n):
     return raw.view(INPUT_DTYPE).reshape(n).copy()
 
 
-def gate_classes(sc: FlightScenario, n: int, seed: int, dwell: int, integral_limit: float | None = None
-                 ) -> dict[str, Batch]:
+def gate_classes(sc: FlightScenario, n: int, seed: int, dwell: int, integral_limit: float | None = None,
+                 config: cs.ControllerConfig | None = None) -> dict[str, Batch]:
     """n independent steps (deterministic in seed), in class order. With `integral_limit`, a share
     of the states hold an integrator just inside its limit, so that a step's error pushes it over
-    (the anti-windup clamp runs)."""
+    (the anti-windup clamp runs); with `config`, an eighth of the bound class flies a 90° roll
+    error (parallel_axis_attitudes)."""
     rng = np.random.default_rng(seed)
     counts = {k: int(n * SHARES.get(k, 0.0)) for k in KINDS}
     counts["inside"] = n - sum(counts.values())
     makers = {"inside": lambda m: inside_inputs(sc, rng, m), "bound": lambda m: bound_inputs(sc, rng, m),
               "invalid": lambda m: invalid_inputs(sc, rng, m), "bits": lambda m: bit_inputs(rng, m)}
     inputs = {k: makers[k](counts[k]) for k in KINDS if counts[k] > 0}
+    if config is not None and counts["bound"] >= 8:
+        rows = inputs["bound"][counts["bound"] - counts["bound"] // 8:]
+        inputs["bound"]["A_bo"][-rows.shape[0]:] = parallel_axis_attitudes(config, rows, rng)
     states = random_states(rng, n, dwell)
     if integral_limit is not None:
         near = np.flatnonzero(rng.random(n) < NEAR_LIMIT_SHARE)

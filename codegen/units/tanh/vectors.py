@@ -1,9 +1,11 @@
 """Gate input classes of the generated tanh-law step (independent (state, input) rows):
   random      random rotations R_c, R_t, rates over several decades, random ϖ
   small       errors of 1e-7 .. 3e-2 rad (x1 inside and around η: f's quadratic patch)
-  delta       ϖ = x2 − δ with ‖δ‖ across n1 and √delta_reg (u_a's inner branch, ρ's switch)
+  delta       ϖ = x2 − δ with ‖δ‖ across n1 and √delta_reg (u_a's inner branch, ρ's switch),
+              some δ components exactly 0 (sig(0)^γ: sg_powf_const's +0 edge)
   singular    errors within 1.5° of 180° and exactly 180°, and across q0 = q0_min
-  off_so3     matrices off SO(3) (noise 1e-6 .. 1, arbitrary matrices)
+  off_so3     matrices off SO(3) (noise 1e-6 .. 1, arbitrary matrices, and R_e = I + a large skew
+              part exactly: the 180° fallback with a zero diagonal excess, e = 0)
   extreme     rates and ϖ over 1e3 .. FLT_MAX (overflow paths, the ϖ clamp)
   special     ±0, subnormals, ±Inf, NaN, ±FLT_MAX in random input/state positions
 Closed-loop sequences need a plant and come from the host (`ClosedLoop`, host.sim.scenarios);
@@ -73,6 +75,7 @@ def _class_delta(k, rng, n):
     out, _ = gt.step(k, np.zeros(n, STATE_DTYPE), x.view(INPUT_DTYPE).reshape(n))
     d = rng.normal(size=(n, 3))
     d *= (np.exp(rng.uniform(np.log(1e-6), np.log(0.3), n)) / np.linalg.norm(d, axis=1))[:, None]
+    d[rng.random((n, 3)) < 0.1] = 0.0   # ϖ_i = x2_i exactly: δ_i = +0
     return (out["x2"].astype(np.float64) - d).astype(F32), x
 
 
@@ -93,6 +96,15 @@ def _class_off_so3(k, rng, n):
     x[:, 0:9] += noise[:, :9].astype(F32)
     x[:, 12:21] += noise[:, 9:].astype(F32)
     x[: n // 4, 0:9] = rng.normal(size=(n // 4, 9)).astype(F32)
+    # R_t = I, R_c = I + [a]x with |a| >= 4: R_e = R_c exactly, trace 3, |x1| >= 1, so the fallback
+    # runs with diagonal excess (1 + 2 max R_e,ii) - trace = 0 and returns e = 0
+    m = n // 8
+    a = _log_uniform(rng, 4.0, 100.0, (m, 3))
+    skew = np.zeros((m, 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -a[:, 2], a[:, 1], -a[:, 0]
+    skew -= skew.transpose(0, 2, 1)
+    x[n - m:, 0:9] = (np.eye(3) + skew).reshape(m, 9).astype(F32)
+    x[n - m:, 12:21] = np.eye(3).reshape(1, 9).astype(F32)
     return state, x
 
 
