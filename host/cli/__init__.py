@@ -35,6 +35,7 @@ COMMANDS = [
     "host.cli.misra",
     "host.cli.cycles",
     "host.cli.impulse",
+    "host.cli.tune",
     "host.cli.tanh",
 ]
 

@@ -63,7 +63,7 @@ def dask_client(scheduler: str | None = None, workers: int | None = None,
 
 
 def run_tasks(client, fn: Callable, tasks: Iterable, weights: Iterable[int], desc: str,
-              progress: bool = True) -> Iterator:
+              progress: bool = True, unit: str = "sample") -> Iterator:
     """Submit fn(task) for every task; yield each result as it finishes, with a progress bar.
 
     `weights` (e.g. samples per shard) drive the bar, so its rate and ETA are in those units.
@@ -74,7 +74,7 @@ def run_tasks(client, fn: Callable, tasks: Iterable, weights: Iterable[int], des
     tasks, weights = list(tasks), list(weights)
     futures = [client.submit(fn, task, pure=False) for task in tasks]
     weight_of = {future.key: w for future, w in zip(futures, weights)}
-    with tqdm(total=sum(weights), unit="sample", desc=desc, file=sys.stderr, disable=not progress,
+    with tqdm(total=sum(weights), unit=unit, desc=desc, file=sys.stderr, disable=not progress,
               smoothing=0.05, dynamic_ncols=True) as bar:
         for future in as_completed(futures):
             yield future.result()
