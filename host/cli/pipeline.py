@@ -107,6 +107,7 @@ def stage_train(ctx: PipelineContext) -> None:
 
     a, report = training.train_artifact(ctx.out / "samples", recipe="default", seed=PRESET_SEED)
     training.save_artifact(a, ctx.out / "network.json")
+    training.save_baselines(report, ctx.out / "network.json")
     atomic.write_text(ctx.out / "training.md", report.summary() + "\n")
     ctx.artifact = a
     ctx.results["network"] = {"artifact": "network.json", "shape": a.shape_text, "sha256": a.sha256,

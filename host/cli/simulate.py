@@ -13,7 +13,8 @@ from codegen import artifact as art
 from host.sim import tanh_example, tanh_in_loop
 from host.cli.args import parse_int, parse_number
 from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
-from host.control.controllers import ARTIFACT_CONTROLLERS, CONTROLLERS
+from host.control.baselines import load_baselines
+from host.control.controllers import ARTIFACT_CONTROLLERS, BASELINE_CONTROLLERS, CONTROLLERS
 from host.errors import HostError
 from host.sim.metrics import ImagingPlan
 from host.sim.simulator import SimConfig
@@ -39,6 +40,8 @@ def register(subparsers) -> None:
     p.add_argument("--artifact", default=None, metavar="FILE",
                    help="model artifact for the network controllers (nn, nn-c, pid-c, nn-arm); "
                         "default: a stand-in network fitted to the PID law")
+    p.add_argument("--baselines", default=None, metavar="FILE",
+                   help="fitted baselines for pdff / linear (network.baselines.json from train or the pipeline)")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
     p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
@@ -115,7 +118,16 @@ def run_tanh_example(args: argparse.Namespace) -> int:
 
 
 def controller_options(args) -> dict:
-    """Factory options: the artifact of a network controller (checked here: a clear user error)."""
+    """Factory options: the artifact of a network controller, the baselines file of a fitted
+    baseline (each checked here: a clear user error)."""
+    if args.baselines is not None and args.controller not in BASELINE_CONTROLLERS:
+        raise HostError(f"--baselines applies to {', '.join(BASELINE_CONTROLLERS)} only")
+    if args.controller in BASELINE_CONTROLLERS:
+        if args.artifact is not None:
+            raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")
+        if args.baselines is not None:
+            load_baselines(args.baselines)   # a missing or invalid file is reported before anything runs
+        return {"baselines": args.baselines}
     if args.controller not in ARTIFACT_CONTROLLERS:
         if args.artifact is not None:
             raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")

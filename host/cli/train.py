@@ -57,8 +57,9 @@ def train_main(args) -> int:
     artifact, report = training.train_artifact(args.data, recipe=args.recipe, seed=seed, epochs=epochs,
                                                hidden=hidden)
     training.save_artifact(artifact, out)
+    laws = training.save_baselines(report, out)
     print(report.summary())
-    print(f"artifact {out} ({artifact.shape_text}, sha256 {artifact.sha256[:16]}…)")
+    print(f"artifact {out} ({artifact.shape_text}, sha256 {artifact.sha256[:16]}…); baselines {laws}")
     return 0
 
 

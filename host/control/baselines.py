@@ -13,6 +13,7 @@ outputs N·m.
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -89,3 +90,50 @@ class SaturatedLinear:
     def predict(self, X: np.ndarray) -> np.ndarray:
         raw = _with_bias(pd_ff_features(X)) @ self.coef
         return raw if self.bound is None else np.clip(raw, -self.bound, self.bound)
+
+
+# ----------------------------------------------------------------------------- file (to fly them)
+
+BASELINES_FORMAT = "staregen-baselines/1"
+_COEF_SHAPES = {"linear": (13, 3), "pdff": (10, 3)}
+
+
+def baselines_document(linear: LinearLS, saturated: SaturatedLinear, dataset_sha256: str) -> dict:
+    """Both fitted laws as JSON (floats as float.hex: the file gives back the very coefficients)."""
+    def hexes(a):
+        return [[float(v).hex() for v in row] for row in np.asarray(a, float)]
+    return {"format": BASELINES_FORMAT, "dataset_sha256": dataset_sha256,
+            "linear": {"coef": hexes(linear.coef)},
+            "pdff": {"coef": hexes(saturated.coef), "bound": saturated.bound, "n_fit": list(saturated.n_fit)}}
+
+
+def _coef(doc: dict, key: str, where: str) -> np.ndarray:
+    try:
+        rows = doc[key]["coef"]
+        a = np.array([[float.fromhex(v) for v in row] for row in rows], dtype=float)
+    except (KeyError, TypeError, ValueError, OverflowError):
+        raise HostError(f"{where}: {key}.coef must be a list of rows of hex floats") from None
+    if a.shape != _COEF_SHAPES[key] or not np.all(np.isfinite(a)):
+        raise HostError(f"{where}: {key}.coef must be {_COEF_SHAPES[key]} finite values, got shape {a.shape}")
+    return a
+
+
+def load_baselines(path) -> tuple[LinearLS, SaturatedLinear]:
+    """The two fitted laws of a baselines file (written by `staregen train` / the pipeline)."""
+    where = str(path)
+    try:
+        doc = json.loads(open(path, encoding="utf-8").read())
+    except OSError as exc:
+        raise HostError(f"{where}: cannot read ({exc.strerror or exc})") from None
+    except ValueError:
+        raise HostError(f"{where}: not valid JSON") from None
+    if not isinstance(doc, dict) or doc.get("format") != BASELINES_FORMAT:
+        raise HostError(f"{where}: not a baselines file (format {BASELINES_FORMAT})")
+    linear, pdff = LinearLS(_coef(doc, "linear", where)), _coef(doc, "pdff", where)
+    bound, n_fit = doc["pdff"].get("bound"), doc["pdff"].get("n_fit")
+    if bound is not None and not (isinstance(bound, (int, float)) and not isinstance(bound, bool)
+                                  and np.isfinite(bound) and bound > 0):
+        raise HostError(f"{where}: pdff.bound must be a positive number or null")
+    if not (isinstance(n_fit, list) and len(n_fit) == 3 and all(isinstance(n, int) and n >= 0 for n in n_fit)):
+        raise HostError(f"{where}: pdff.n_fit must be 3 sample counts")
+    return linear, SaturatedLinear(pdff, None if bound is None else float(bound), tuple(n_fit))

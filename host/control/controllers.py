@@ -53,9 +53,13 @@ CONTROLLERS = {
     "nn-c": "host.control.generated_controller:make_sil_controller",
     "pid-c": "host.control.generated_controller:make_sil_pid_controller",
     "nn-arm": "host.control.generated_controller:make_pil_controller",
+    "pdff": "host.control.baseline_controllers:make_pdff_controller",
+    "linear": "host.control.baseline_controllers:make_linear_controller",
 }
 # Controllers built from a model artifact accept `artifact=` (a file path, None = the stand-in).
 ARTIFACT_CONTROLLERS = ("nn", "nn-c", "pid-c", "nn-arm")
+# The fitted baselines accept `baselines=` (a baselines file written by `staregen train`).
+BASELINE_CONTROLLERS = ("pdff", "linear")
 
 
 def build_controller(name: str, *, torque_limit: float, control_period: float, **options) -> Controller:

@@ -24,14 +24,15 @@ import math
 import os
 import tempfile
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
 from codegen import artifact as art
+from codegen import atomic
 from codegen.units.network import reference
-from host.control.baselines import LinearLS, SaturatedLinear
+from host.control.baselines import LinearLS, SaturatedLinear, baselines_document
 from host.errors import HostError
 
 TRAIN_FRACTION = 0.75
@@ -371,9 +372,11 @@ class TrainReport:
     train_seconds: float        # the net's optimisation only
     total_seconds: float = 0.0  # load, split, baselines, training, export
     choice: dict | None = None  # from a sweep: the grid, the overall best and the exported tansig
+    # the fitted baselines as a baselines file (host.control.baselines), to fly them; not metadata
+    baseline_laws: dict = field(default_factory=dict)
 
     def metadata(self) -> dict:
-        meta = {k: v for k, v in asdict(self).items() if k not in ("train_seconds", "total_seconds")}
+        meta = {k: v for k, v in asdict(self).items() if k not in ("train_seconds", "total_seconds", "baseline_laws")}
         meta.update(creator="staregen train (host.learn.training)", test_mse=self.net["mse_mean_normalised"],
                     test_mse_definition=TEST_MSE_DEFINITION,
                     relative_torque_error_definition=RELATIVE_ERROR_DEFINITION,
@@ -425,11 +428,13 @@ def torque_bound_of(report: dict) -> float | None:
     return (report.get("ocp") or {}).get("torque_bound")
 
 
-def fit_baselines(split: Split, bound: float | None) -> dict:
+def fit_baselines(split: Split, bound: float | None) -> tuple[dict, tuple[LinearLS, SaturatedLinear]]:
+    """Test metrics of the two baselines (name -> metrics) and the fitted laws themselves."""
     linear = LinearLS.fit(split.X_train, split.Y_train)
     saturated = SaturatedLinear.fit(split.X_train, split.Y_train, bound)
-    return {model.name: error_metrics(split.Y_test, model.predict(split.X_test), split.output_map)
-            for model in (linear, saturated)}
+    metrics = {model.name: error_metrics(split.Y_test, model.predict(split.X_test), split.output_map)
+               for model in (linear, saturated)}
+    return metrics, (linear, saturated)
 
 
 def export(fit: FitResult, split: Split, metadata: dict | None = None) -> art.Artifact:
@@ -451,6 +456,22 @@ def check_writable(path) -> Path:
     except OSError as exc:
         raise HostError(f"{path}: cannot write the artifact ({exc.strerror or exc})") from None
     return path
+
+
+def baselines_path(artifact_path) -> Path:
+    """Where the fitted baselines of an artifact go: network.json -> network.baselines.json."""
+    p = Path(artifact_path)
+    return p.with_name(f"{p.stem}.baselines.json")
+
+
+def save_baselines(report: TrainReport, artifact_path) -> Path:
+    """The fitted baselines next to the artifact (atomic), so that `simulate --controller
+    pdff|linear --baselines FILE` can fly them."""
+    path = baselines_path(artifact_path)
+    try:
+        return atomic.write_json(path, report.baseline_laws)
+    except OSError as exc:
+        raise HostError(f"{path}: cannot write the baselines ({exc.strerror or exc})") from None
 
 
 def save_artifact(artifact: art.Artifact, path) -> Path:
@@ -475,11 +496,13 @@ def train_artifact(data, recipe: str | Recipe = "default", seed: int = 0, epochs
     recipe = recipe if isinstance(recipe, Recipe) else recipe_named(recipe, epochs)
     split = make_split(X, Y, seed)
     fit = fit_network(split, EXPORTABLE_ACTIVATION, hidden, recipe, seed)
+    baseline_metrics, baseline_models = fit_baselines(split, torque_bound_of(dataset_report))
     report = TrainReport(
         activation=EXPORTABLE_ACTIVATION, hidden=hidden, recipe=asdict(recipe), seed=seed,
         n_train=len(split.X_train), n_test=len(split.X_test), dataset=_dataset_summary(dataset_report),
-        dataset_sha256=dataset_sha256(X, Y), net={}, baselines=fit_baselines(split, torque_bound_of(dataset_report)),
+        dataset_sha256=dataset_sha256(X, Y), net={}, baselines=baseline_metrics,
         train_mse_normalised=fit.train_mse_normalised, train_seconds=fit.train_seconds, choice=choice)
+    report.baseline_laws = baselines_document(*baseline_models, report.dataset_sha256)
     # Metrics of what flies: the artifact's float32 weights (float64 arithmetic); filled in, then sealed.
     unsealed = export(fit, split)
     report.net = error_metrics(split.Y_test, reference.reference_eval64(unsealed, split.X_test), split.output_map)
