@@ -130,15 +130,30 @@ def _dcm_from_euler312(A):
         (st * cp + ct * sf * sp, st * sp - ct * sf * cp, ct * cf))])
 
 
+def _euler312_from_entries(entry) -> np.ndarray:
+    """host.core.rotations.euler312_from_dcm from an entry(i, k) function of the DCM."""
+    phi = np.arcsin(np.clip(entry(1, 2), -1.0, 1.0))
+    psi = np.arctan2(-entry(1, 0), entry(1, 1))
+    theta = np.arctan2(-entry(0, 2), entry(2, 2))
+    return np.stack([phi, theta, psi])
+
+
+def _euler312(L):
+    return _euler312_from_entries(lambda i, k: L[i, k])
+
+
 def _euler312_of_product(L, R_t):
     """euler312(L · R^T) for L (3, 3, T, B) and per-target R (T, 3, 3): only the five entries the
     angles need, each a row of L dotted with a row of R."""
     def entry(i, k):
         return (L[i, 0] * R_t[:, k, 0, None] + L[i, 1] * R_t[:, k, 1, None]) + L[i, 2] * R_t[:, k, 2, None]
-    phi = np.arcsin(np.clip(entry(1, 2), -1.0, 1.0))
-    psi = np.arctan2(-entry(1, 0), entry(1, 1))
-    theta = np.arctan2(-entry(0, 2), entry(2, 2))
-    return np.stack([phi, theta, psi])
+    return _euler312_from_entries(entry)
+
+
+def _matmul(A, B):
+    """(3, 3, T, B) · (3, 3, T, B), entry by entry."""
+    return np.stack([np.stack([(A[i, 0] * B[0, k] + A[i, 1] * B[1, k]) + A[i, 2] * B[2, k] for k in range(3)])
+                     for i in range(3)])
 
 
 def _quat_rate(q, w):
@@ -307,8 +322,9 @@ def simulate_pid_batch(targets: Sequence[tuple[float, float]], gains: GainSets, 
         A_bo = _euler312_of_product(L_bi, np.broadcast_to(env.L_oi[j0], (T, 3, 3)))
         if cfg.sensor_errors:
             A_bo = (A_bo + star_bias) + _per_scenario(star, G, k)
-        if cfg.attitude_offset is not None:
-            A_bo = A_bo + _broadcast_input(cfg.attitude_offset(t0), T, B)
+        if cfg.attitude_offset is not None:   # a body-axes rotation of the measured attitude
+            R = _dcm_from_euler312(np.broadcast_to(_broadcast_input(cfg.attitude_offset(t0), T, B), (3, T, B)))
+            A_bo = _euler312(_matmul(R, _dcm_from_euler312(A_bo)))
         w_meas = x[4:7]
         if cfg.sensor_errors:
             w_meas = (w_meas + gyro_bias) + _per_scenario(gyro, G, k)

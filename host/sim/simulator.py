@@ -43,7 +43,7 @@ from host.plant.disturbances import DEFAULT_DISTURBANCES, DisturbanceParams, tot
 from host.plant.environment import EnvironmentTrack
 from host.errors import HostError
 from host.gnc.guidance import desired_state
-from host.core.rotations import dcm_from_quat, euler312_from_dcm, quat_from_dcm
+from host.core.rotations import dcm_from_euler312, dcm_from_quat, euler312_from_dcm, quat_from_dcm
 from host.plant.sensors import TABLE6_SENSORS, Gps, Gyro, SensorErrors, StarSensor
 from host.plant.spacecraft import (TABLE6, ReactionWheels, SpacecraftParams, momentum_limited_torque,
                              pack_state, rk4_step, unpack_state)
@@ -67,7 +67,10 @@ class SimConfig:
     external_torques: bool = True     # False: no environmental disturbances
     # test inputs (step / frequency / impulse responses): functions of t [s] -> (3,)
     extra_torque: Callable[[float], np.ndarray] | None = None      # N·m on the body
-    attitude_offset: Callable[[float], np.ndarray] | None = None   # rad added to measured A_bo
+    # rad, 3-1-2 angles of a small rotation about the body axes applied to the star sensor's
+    # measured attitude (L_bo -> R(offset)·L_bo): the controller's own A_bd moves by it (to first
+    # order), whatever the off-nadir angle; the §7.6.1 "extra angle measurement error"
+    attitude_offset: Callable[[float], np.ndarray] | None = None
 
     @property
     def substeps(self) -> int:
@@ -146,7 +149,7 @@ def _measure(x, env, k_sample, t, star, gyro, gps, lon, lat, cfg: SimConfig) -> 
     L_bo = dcm_from_quat3(q) @ env.L_oi[k_sample].T
     A_bo = star.measure(euler312_from_dcm(L_bo))
     if cfg.attitude_offset is not None:
-        A_bo = A_bo + np.asarray(cfg.attitude_offset(t), float)
+        A_bo = euler312_from_dcm(dcm_from_euler312(np.asarray(cfg.attitude_offset(t), float)) @ dcm_from_euler312(A_bo))
     R, V = gps.measure(env.R[k_sample], env.V[k_sample])
     return Measurement(t=t, jd_days=int(env.jd_days[k_sample]), sec_of_day=float(env.sec_of_day[k_sample]),
                        A_bo=A_bo, omega_b=gyro.measure(w), R_s=R, V_s=V, lon=lon, lat=lat)
