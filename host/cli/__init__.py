@@ -36,6 +36,7 @@ COMMANDS = [
     "host.cli.cycles",
     "host.cli.impulse",
     "host.cli.tune",
+    "host.cli.evaluate",
     "host.cli.tanh",
 ]
 

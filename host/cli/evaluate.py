@@ -1,0 +1,107 @@
+"""`staregen evaluate`: paper 001 §7's comparisons (Tables 8-11, Figs. 10-15) for the network, the
+PID with Table 1 gains, the tuned PID and the PD + feed-forward baseline; evaluate.json + PNGs.
+
+  --network FILE       the trained artifact (its baselines file next to it is used for PD+FF)
+  --tuned FILE         a controller.toml from `staregen tune pid` (adds the tuned PID row)
+  --sil / --pil        add the generated C in the loop: SIL over the targets, PIL on the central one
+"""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from codegen import artifact as art
+from codegen import atomic
+from codegen.package import config as pc
+from host.cli.args import parse_int, parse_number
+from host.cli.tune import parse_targets
+from host.control.baselines import load_baselines
+from host.errors import HostError
+from host.learn.training import baselines_path
+from host.sim import impulse
+from host.sim.targets import central_target
+from host.tune import figures
+from host.tune.evaluate import ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("evaluate", help="paper 001 §7 comparisons: staring, step, frequency, impulse",
+                              description=__doc__.splitlines()[0])
+    p.add_argument("--network", required=True, metavar="FILE", help="trained 12-40-3 artifact")
+    p.add_argument("--baselines", default=None, metavar="FILE",
+                   help="fitted baselines (default: <network>.baselines.json when it exists)")
+    p.add_argument("--tuned", default=None, metavar="FILE", help="controller.toml with tuned PID gains")
+    p.add_argument("--targets", default="all", help="staring targets: all, central or N (the first N of the 100)")
+    p.add_argument("--response-targets", default="10", help="targets averaged in the step response (default 10)")
+    p.add_argument("--duration", default="100", help="staring run length in s (default 100)")
+    p.add_argument("--freqs", default="0.02,0.05,0.1,0.2,0.5,1,2,3,4.5", help="frequency grid in Hz")
+    p.add_argument("--seed", default="0", help="noise seed (default 0)")
+    p.add_argument("--sil", action="store_true", help="add the generated C (x86, cffi) over the targets")
+    p.add_argument("--pil", action="store_true", help="add the generated C in the ARM emulator, central target")
+    p.add_argument("--workers", default=None, help="worker processes (default: all cores)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    p.add_argument("--out", required=True, help="output folder (created)")
+    p.set_defaults(func=run)
+
+
+def controller_specs(args) -> list[ControllerSpec]:
+    art.load(args.network)   # a missing or invalid file is reported before anything runs
+    specs = [table1_spec()]
+    if args.tuned:
+        c = pc.load(args.tuned).controller
+        specs.append(tuned_spec(c.kp, c.ki, c.kd))
+    specs.append(ControllerSpec("NN (float64)", "nn", (("artifact", args.network),)))
+    if args.sil:
+        specs.append(ControllerSpec("NN (SIL, x86 C)", "nn-c", (("artifact", args.network),)))
+    if args.pil:
+        specs.append(ControllerSpec("NN (PIL, ARM, central)", "nn-arm", (("artifact", args.network),)))
+    laws = args.baselines or (str(baselines_path(args.network)) if baselines_path(args.network).exists() else None)
+    if laws:
+        load_baselines(laws)
+        specs.append(ControllerSpec("PD+FF", "pdff", (("baselines", laws),)))
+    return specs
+
+
+def parse_freqs(text: str) -> tuple[float, ...]:
+    parts = [p for p in text.split(",") if p.strip()]
+    if not parts:
+        raise HostError("--freqs needs at least one frequency")
+    return tuple(parse_number(p, "--freqs", positive=True, maximum=4.99) for p in parts)
+
+
+def run(args: argparse.Namespace) -> int:
+    targets = parse_targets(args.targets)
+    n_resp = parse_int(args.response_targets, "--response-targets", minimum=1, maximum=len(targets))
+    c = central_target()
+    plan = EvalPlan(targets=targets, response_targets=targets[:n_resp], central=(c.name, c.lon, c.lat, 0),
+                    duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
+                    seed=parse_int(args.seed, "--seed", maximum=2**32 - 1), freqs=parse_freqs(args.freqs))
+    workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1, maximum=256)
+    specs = controller_specs(args)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise HostError(f"output folder {out} exists and is not a directory")
+    result = evaluate(plan, specs, workers, progress=not args.no_progress)
+    imp = impulse.run("nn", args.network, seed=plan.seed)
+    result["impulse"] = imp.as_dict()
+    out.mkdir(parents=True, exist_ok=True)
+    figures.fig10_scatter(result["staring"], out / "fig10_scatter.png")
+    figures.fig11_12_step(result["step"], out / "fig11_12_step.png")
+    figures.fig13_14_frequency(result["frequency"], out / "fig13_14_frequency.png")
+    impulse.plot(imp, out / "fig15_impulse.png", "NN (float64)")
+    atomic.write_json(out / "evaluate.json", result)
+    print(summary(result))
+    print(f"wrote {out}/evaluate.json and 4 figures")
+    return 0
+
+
+def summary(result: dict) -> str:
+    lines = [f"{'controller':26s} {'targets':>7s} {'J_A [°]':>10s} {'J_w [°/s]':>10s} {'J':>10s}"]
+    for label, r in result["staring"].items():
+        lines.append(f"{label:26s} {r['targets']:7d} {r['J_A']:10.3e} {r['J_w']:10.3e} {r['J']:10.3e}")
+    lines.append("step response (mean over targets; x, y, z): overshoot %, settling s, steady-state error °")
+    for label, s in result["step"].items():
+        m = s["mean"]
+        lines.append(f"  {label:24s} " + "  ".join(
+            f"{k.split('_')[0]} " + ", ".join(f"{v:.3g}" for v in m[k]) for k in m))
+    return "\n".join(lines)
