@@ -37,6 +37,7 @@ COMMANDS = [
     "host.cli.impulse",
     "host.cli.tune",
     "host.cli.evaluate",
+    "host.cli.report",
     "host.cli.tanh",
 ]
 

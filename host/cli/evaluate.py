@@ -45,7 +45,9 @@ def register(subparsers) -> None:
 
 
 def controller_specs(args) -> list[ControllerSpec]:
-    art.load(args.network)   # a missing or invalid file is reported before anything runs
+    a = art.load(args.network)   # a missing or invalid file is reported before anything runs
+    if a.sizes[0] != 12 or a.sizes[-1] != 3:
+        raise HostError(f"--network: the network controller needs a 12-input, 3-output network, got {a.shape_text}")
     specs = [table1_spec()]
     if args.tuned:
         c = pc.load(args.tuned).controller

@@ -120,14 +120,15 @@ def run_tanh_example(args: argparse.Namespace) -> int:
 def controller_options(args) -> dict:
     """Factory options: the artifact of a network controller, the baselines file of a fitted
     baseline (each checked here: a clear user error)."""
-    if args.baselines is not None and args.controller not in BASELINE_CONTROLLERS:
+    baselines = getattr(args, "baselines", None)   # commands without --baselines (impulse) fly no baseline
+    if baselines is not None and args.controller not in BASELINE_CONTROLLERS:
         raise HostError(f"--baselines applies to {', '.join(BASELINE_CONTROLLERS)} only")
     if args.controller in BASELINE_CONTROLLERS:
         if args.artifact is not None:
             raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")
-        if args.baselines is not None:
-            load_baselines(args.baselines)   # a missing or invalid file is reported before anything runs
-        return {"baselines": args.baselines}
+        if baselines is not None:
+            load_baselines(baselines)   # a missing or invalid file is reported before anything runs
+        return {"baselines": baselines}
     if args.controller not in ARTIFACT_CONTROLLERS:
         if args.artifact is not None:
             raise HostError(f"--artifact applies to {', '.join(ARTIFACT_CONTROLLERS)} only")

@@ -246,7 +246,8 @@ def evaluate(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress
         raise HostError(f"controllers listed twice: {labels}")
     times = {}
     t0 = time.perf_counter()
-    result = {"staring": staring(plan, specs, workers, progress)}
+    result = {"staring": staring(plan, specs, workers, progress),
+              "staring_central": staring(replace(plan, targets=(plan.central,)), specs, workers, progress)}
     times["staring_s"] = round(time.perf_counter() - t0, 2)
     t0 = time.perf_counter()
     result["step"] = step_response(plan, specs, workers, progress)

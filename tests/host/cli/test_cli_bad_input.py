@@ -130,6 +130,13 @@ CASES = [
     (["tune", "pid", "--targets", "0", "--out", "{tmp}/t"], "--targets"),
     (["tune", "pid", "--seeds", "1,1", "--out", "{tmp}/t"], "twice"),
     (["tune", "pid", "--config", "{net}", "--out", "{tmp}/t"], "not valid TOML"),
+    (["evaluate", "--network", "{small}", "--out", "{tmp}/e"], "12-input"),
+    (["evaluate", "--network", "{net}", "--freqs", "7", "--out", "{tmp}/e"], "--freqs"),
+    (["evaluate", "--network", "{net}", "--targets", "3", "--response-targets", "4", "--out", "{tmp}/e"],
+     "--response-targets"),
+    (["evaluate", "--network", "{net}", "--tuned", "{net}", "--out", "{tmp}/e"], "not valid TOML"),
+    (["report", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"], "not a folder"),
+    (["report", "--evaluate", "{dir}", "--out", "{tmp}/r"], "evaluate.json"),
 ]
 
 

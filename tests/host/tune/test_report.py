@@ -1,0 +1,91 @@
+"""`staregen report`: every table and every figure of the evaluation in report.html (parsed), the
+same tables in report.md, the paper's numbers beside ours, hostile text escaped."""
+from __future__ import annotations
+
+import json
+from html.parser import HTMLParser
+
+import numpy as np
+
+from host.cli import main
+from host.tune import figures
+from host.tune.report import PAPER_TABLE9
+
+
+class Collect(HTMLParser):
+    def __init__(self):
+        super().__init__()
+        self.tables, self.imgs, self.cells, self._in = 0, [], [], None
+
+    def handle_starttag(self, tag, attrs):
+        if tag == "table":
+            self.tables += 1
+        if tag == "img":
+            self.imgs.append(dict(attrs))
+        if tag in ("td", "th"):
+            self._in = tag
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th"):
+            self._in = None
+
+    def handle_data(self, data):
+        if self._in:
+            self.cells.append(data)
+
+
+def _evaluation(label_hostile: str) -> dict:
+    def row(j):
+        return {"J_A": j, "J_w": j / 5, "J": 2 * j, "targets": 3, "per_target": {"J_A": [j] * 3, "J_w": [j / 5] * 3}}
+    staring = {"PID (Table 1)": row(5e-4), "PID (tuned)": row(4e-4), "NN (float64)": row(3e-4), label_hostile: row(6e-4)}
+    t = list(np.arange(25.0, 60.0, 0.1))
+    resp = [[-0.005 * (1 - np.exp(-max(x - 30, 0) / 2))] * 3 for x in t]
+    step = {k: {"mean": {"overshoot_pct": [1, 2, 3], "settling_s": [4, 5, 6], "steady_state_deg": [1e-5, 2e-5, 3e-5]},
+                "targets": 1, "first_target_response_deg": resp, "t": t} for k in staring}
+    freq = {k: {"freqs_hz": [0.1, 1.0, 3.0], "amplitude_deg": [[1e-3, 1e-4, 1e-5]] * 3} for k in staring}
+    return {"staring": staring, "staring_central": staring, "step": step, "frequency": freq,
+            "impulse": {"t_pid_first_s": 30.0, "t_nn_back_s": 41.2, "peak_A_bd_deg": 0.3, "final_max_A_bd_deg": 1e-3},
+            "timing": {"staring_s": 1.0}}
+
+
+def test_report_holds_every_table_and_figure(tmp_path):
+    ev = tmp_path / "ev"
+    ev.mkdir()
+    hostile = "<script>alert(1)</script> | PD+FF"
+    doc = _evaluation(hostile)
+    (ev / "evaluate.json").write_text(json.dumps(doc))
+    figures.fig10_scatter(doc["staring"], ev / "fig10_scatter.png")
+    figures.fig11_12_step(doc["step"], ev / "fig11_12_step.png")
+    figures.fig13_14_frequency(doc["frequency"], ev / "fig13_14_frequency.png")
+    tune = tmp_path / "tune"
+    tune.mkdir()
+    (tune / "result.json").write_text(json.dumps({
+        "grid": "coarse", "triples": 60, "targets": 3, "duration": 20.0, "timing": {"wall_seconds": 3.0},
+        "best": {a: {"kp": 17.0, "ki": 0.0, "kd": 46.0, "objective": 1e-4, "table1_on_grid": True,
+                     "table1_objective": 2e-4} for a in "xyz"},
+        "check": {"table1": {"J": 1e-3}, "tuned": {"J": 8e-4}, "ratio_tuned_to_table1": 0.8}}))
+    assert main(["report", "--evaluate", str(ev), "--tune", str(tune), "--out", str(tmp_path / "r")]) == 0
+    text = (tmp_path / "r" / "report.html").read_text()
+    p = Collect()
+    p.feed(text)
+    # tuning, Table 8, Table 9, step, frequency
+    assert p.tables == 5
+    assert len(p.imgs) == 3 and all(i["src"].startswith("data:image/png;base64,") for i in p.imgs)
+    assert "<script>" not in text and "&lt;script&gt;" in text
+    assert f"{PAPER_TABLE9['NN'][2]:.3g}" in p.cells and f"{PAPER_TABLE9['PID'][2]:.3g}" in p.cells
+    md = (tmp_path / "r" / "report.md").read_text()
+    assert md.count("\n|---|") == 5 and md.count("![") == 3
+    assert all((tmp_path / "r" / n).is_file() for n in ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png"))
+    assert "Reading: NN / best PID" in md
+
+
+def test_bad_inputs(tmp_path, capsys):
+    assert main(["report", "--evaluate", str(tmp_path / "none"), "--out", str(tmp_path / "r")]) == 2
+    assert "not a folder" in capsys.readouterr().err
+    (tmp_path / "ev").mkdir()
+    (tmp_path / "ev" / "evaluate.json").write_text("{")
+    assert main(["report", "--evaluate", str(tmp_path / "ev"), "--out", str(tmp_path / "r")]) == 2
+    assert "not valid JSON" in capsys.readouterr().err
+    (tmp_path / "ev" / "evaluate.json").write_text("{}")
+    assert main(["report", "--evaluate", str(tmp_path / "ev"), "--out", str(tmp_path / "r")]) == 2
+    assert "not written by" in capsys.readouterr().err
