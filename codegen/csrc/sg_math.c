@@ -169,11 +169,9 @@ const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] = {
     /* END sg_tanh_tab */
 };
 
-/* Magnitude bits of x (2 per ulp) above those of 2^-12, the start of interval 0: the interval
- * is d >> (24 - SG_TANH_M), i.e. sg_tanh_index(ux), and d >= SG_TANH_D_END outside [2^-12, 9). */
-#define SG_TANH_SHIFT (24u - SG_TANH_M)
-#define SG_TANH_D_END (SG_TANH_N << SG_TANH_SHIFT)
-#define SG_TANH_D_INF (0xff000000u - (SG_TANH_FIRST << SG_TANH_SHIFT)) /* d of +-Inf */
+/* d = (ux << 1) - SG_TANH_D_FIRST: magnitude bits of x (2 per ulp) above those of 2^-12, the
+ * start of interval 0; the interval is d >> SG_TANH_SHIFT, i.e. sg_tanh_index(ux), and
+ * d >= SG_TANH_D_END outside [2^-12, 9) (SG_TANH_SHIFT, SG_TANH_D_*: sg_math.h). */
 
 /* Outside [2^-12, 9): x itself for NaN (NaN in, NaN out) and for |x| < 2^-12 (also +-0,
  * subnormals: d wrapped around), else +-1 (|x| >= 9, +-Inf; tanh 9 is within 0.52 ulp of 1).
@@ -181,10 +179,11 @@ const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] = {
  * neuron. */
 static float sg_tanh_outside(float x, uint32_t ux, uint32_t d)
 {
-    if (d > SG_TANH_D_INF) {
-        return x;
+    float r = x;
+    if (d <= SG_TANH_D_INF) {
+        r = sg_as_f32((ux & 0x80000000u) | 0x3f800000u); /* +-1 from the sign bit: no IT block */
     }
-    return sg_as_f32((ux & 0x80000000u) | 0x3f800000u); /* +-1 from the sign bit: no IT block */
+    return r;
 }
 
 /* tanh(x) = MATLAB tansig(x); odd: the sign is applied last from the sign bit. The interval
@@ -192,11 +191,14 @@ static float sg_tanh_outside(float x, uint32_t ux, uint32_t d)
 float sg_tanhf(float x)
 {
     uint32_t ux = sg_as_u32(x);
-    uint32_t d = (ux << 1) - (SG_TANH_FIRST << SG_TANH_SHIFT);
-    if (__builtin_expect(d >= SG_TANH_D_END, 0)) {
-        return sg_tanh_outside(x, ux, d);
+    uint32_t d = (ux << 1) - SG_TANH_D_FIRST;
+    float r;
+    if (__builtin_expect(d >= SG_TANH_D_END, 0) != 0) {
+        r = sg_tanh_outside(x, ux, d);
+    } else {
+        r = sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, ux);
     }
-    return sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, ux);
+    return r;
 }
 
 /* ------------------------------------------------------------------ exp */
@@ -227,37 +229,37 @@ static float sg_pow2(uint32_t u, uint32_t bias)
 static float sg_expm1_kernel(float r)
 {
     float p = 0x1.6c5a98p-10f;
-    p = p * r + 0x1.12243ap-7f;
-    p = p * r + 0x1.5555b6p-5f;
-    p = p * r + 0x1.5554b6p-3f;
-    p = p * r + 0.5f;
-    p = p * r + 1.0f;
+    p = (p * r) + 0x1.12243ap-7f;
+    p = (p * r) + 0x1.5555b6p-5f;
+    p = (p * r) + 0x1.5554b6p-3f;
+    p = (p * r) + 0.5f;
+    p = (p * r) + 1.0f;
     return p * r;
 }
 
 /* e^x for |x| > 87 (k = round(x/ln2) may leave [-126, 127]), NaN, +-Inf. */
 static float sg_exp_outer(float x)
 {
-    if (!(x <= SG_EXP_OVF && x >= SG_EXP_UNF)) {
+    if (!((x <= SG_EXP_OVF) && (x >= SG_EXP_UNF))) {
         if (x != x) {
             return x + x;
         }
-        return x > 0.0f ? sg_inf() : 0.0f;
+        return (x > 0.0f) ? sg_inf() : 0.0f;
     }
-    float t = x * SG_INV_LN2 + SG_MAGIC;
+    float t = (x * SG_INV_LN2) + SG_MAGIC;
     float kf = t - SG_MAGIC;
-    float q = sg_expm1_kernel((x - kf * SG_LN2_HI) - kf * SG_LN2_LO);
+    float q = sg_expm1_kernel((x - (kf * SG_LN2_HI)) - (kf * SG_LN2_LO));
     uint32_t u = sg_as_u32(t);
-    if (kf >= -126.0f && kf <= 127.0f) {
+    if ((kf >= -126.0f) && (kf <= 127.0f)) {
         float s = sg_pow2(u, 0u);
-        return s + s * q;
+        return s + (s * q);
     }
     if (kf > 0.0f) {
         float s = sg_pow2(u, (uint32_t)-1);
-        return (s + s * q) * 2.0f;
+        return (s + (s * q)) * 2.0f;
     }
     float s = sg_pow2(u, 64u);
-    return (s + s * q) * 0x1p-64f;
+    return (s + (s * q)) * 0x1p-64f;
 }
 
 /*
@@ -268,14 +270,17 @@ static float sg_exp_outer(float x)
  */
 float sg_expf(float x)
 {
+    float r;
     if (__builtin_expect(!(__builtin_fabsf(x) <= 87.0f), 0) != 0) {
-        return sg_exp_outer(x);
+        r = sg_exp_outer(x);
+    } else {
+        float t = (x * SG_INV_LN2) + SG_MAGIC;
+        float kf = t - SG_MAGIC;
+        float q = sg_expm1_kernel((x - (kf * SG_LN2_HI)) - (kf * SG_LN2_LO));
+        float s = sg_pow2(sg_as_u32(t), 0u);
+        r = s + (s * q);
     }
-    float t = x * SG_INV_LN2 + SG_MAGIC;
-    float kf = t - SG_MAGIC;
-    float q = sg_expm1_kernel((x - kf * SG_LN2_HI) - kf * SG_LN2_LO);
-    float s = sg_pow2(sg_as_u32(t), 0u);
-    return s + s * q;
+    return r;
 }
 
 /* ------------------------------------------------------------------ log */
@@ -289,11 +294,11 @@ float sg_logf(float x)
 {
     uint32_t ix = sg_as_u32(x);
     float kbias = 0.0f;
-    if (__builtin_expect(ix < 0x00800000u || ix >= 0x7f800000u, 0)) {
+    if (__builtin_expect((ix < 0x00800000u) || (ix >= 0x7f800000u), 0) != 0) {
         if ((ix << 1) == 0u) {
             return -sg_inf();
         }
-        if (x != x || ix == 0x7f800000u) {
+        if ((x != x) || (ix == 0x7f800000u)) {
             return x + x;
         }
         if ((ix >> 31) != 0u) {
@@ -303,16 +308,17 @@ float sg_logf(float x)
         kbias = -23.0f;
     }
     ix += 0x3f800000u - 0x3f3504f3u;
-    float kf = (float)((int32_t)(ix >> 23) - 127) + kbias;
+    int32_t k = (int32_t)(ix >> 23) - 127;
+    float kf = (float)k + kbias;
     float f = sg_as_f32((ix & 0x007fffffu) + 0x3f3504f3u) - 1.0f;
     float s = f / (2.0f + f);
     float z = s * s;
     float rz = 0x1.2f29fep-2f;
-    rz = rz * z + 0x1.997aa8p-2f;
-    rz = rz * z + 0x1.55555cp-1f;
+    rz = (rz * z) + 0x1.997aa8p-2f;
+    rz = (rz * z) + 0x1.55555cp-1f;
     rz = rz * z;
     float hfsq = 0.5f * f * f;
-    return (((s * (hfsq + rz) + kf * SG_LN2_LO) - hfsq) + f) + kf * SG_LN2_HI;
+    return ((((s * (hfsq + rz)) + (kf * SG_LN2_LO)) - hfsq) + f) + (kf * SG_LN2_HI);
 }
 
 /* ------------------------------------------------------------------ sin, cos */
@@ -331,9 +337,9 @@ static float sg_sin_kernel(float hi, float lo)
 {
     float z = hi * hi;
     float p = -0x1.9952ecp-13f;
-    p = p * z + 0x1.110776p-7f;
-    p = p * z - 0x1.555546p-3f;
-    return hi + (hi * (z * p) + lo);
+    p = (p * z) + 0x1.110776p-7f;
+    p = (p * z) - 0x1.555546p-3f;
+    return hi + ((hi * (z * p)) + lo);
 }
 
 /* cos(hi + lo) on |hi| <= pi/4: 1 - (z/2 - (z^2 (c4 + c6 z + c8 z^2) - hi lo)). */
@@ -341,9 +347,9 @@ static float sg_cos_kernel(float hi, float lo)
 {
     float z = hi * hi;
     float p = 0x1.9b8a82p-16f;
-    p = p * z - 0x1.6c123cp-10f;
-    p = p * z + 0x1.555554p-5f;
-    return 1.0f - (0.5f * z - (z * (z * p) - hi * lo));
+    p = (p * z) - 0x1.6c123cp-10f;
+    p = (p * z) + 0x1.555554p-5f;
+    return 1.0f - ((0.5f * z) - ((z * (z * p)) - (hi * lo)));
 }
 
 /*
@@ -355,28 +361,31 @@ static float sg_cos_kernel(float hi, float lo)
  */
 static float sg_trig(float x, uint32_t shift)
 {
-    float t = x * SG_TWO_OVER_PI + SG_MAGIC;
+    float t = (x * SG_TWO_OVER_PI) + SG_MAGIC;
     float jf = t - SG_MAGIC;
-    float t2 = (x - jf * SG_PIO2_1) - jf * SG_PIO2_2;
+    float t2 = (x - (jf * SG_PIO2_1)) - (jf * SG_PIO2_2);
     float w = jf * SG_PIO2_3;
     float hi = t2 - w;
-    float lo = ((t2 - hi) - w) - jf * SG_PIO2_4;
+    float lo = ((t2 - hi) - w) - (jf * SG_PIO2_4);
     if (__builtin_expect(!(__builtin_fabsf(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
-        hi = hi > SG_PIO4 ? SG_PIO4 : (hi < -SG_PIO4 ? -SG_PIO4 : hi);
+        hi = (hi > SG_PIO4) ? SG_PIO4 : ((hi < -SG_PIO4) ? -SG_PIO4 : hi);
         lo = 0.0f;
     }
     uint32_t n = sg_as_u32(t) + shift;
-    float y = (n & 1u) ? sg_cos_kernel(hi, lo) : sg_sin_kernel(hi, lo);
-    return (n & 2u) ? -y : y;
+    float y = ((n & 1u) != 0u) ? sg_cos_kernel(hi, lo) : sg_sin_kernel(hi, lo);
+    return ((n & 2u) != 0u) ? -y : y;
 }
 
 float sg_sinf(float x)
 {
     /* sin x rounds to x below 2^-12; also keeps sin(-0) = -0 and passes NaN. */
+    float r;
     if (!(__builtin_fabsf(x) >= 0x1p-12f)) {
-        return x;
+        r = x;
+    } else {
+        r = sg_trig(x, 0u);
     }
-    return sg_trig(x, 0u);
+    return r;
 }
 
 float sg_cosf(float x)
@@ -395,10 +404,10 @@ float sg_cosf(float x)
 static float sg_asin_tail(float x, float z)
 {
     float p = 0x1.596d5cp-5f;
-    p = p * z + 0x1.8c2d86p-6f;
-    p = p * z + 0x1.747d06p-5f;
-    p = p * z + 0x1.3301fcp-4f;
-    p = p * z + 0x1.5555c8p-3f;
+    p = (p * z) + 0x1.8c2d86p-6f;
+    p = (p * z) + 0x1.747d06p-5f;
+    p = (p * z) + 0x1.3301fcp-4f;
+    p = (p * z) + 0x1.5555c8p-3f;
     return x * (z * p);
 }
 
@@ -410,20 +419,23 @@ static float sg_asin_tail(float x, float z)
 float sg_asinf(float x)
 {
     float a = __builtin_fabsf(x);
+    float r;
     if (__builtin_expect(!(a <= 1.0f), 0) != 0) {
-        return x != x ? x + x : sg_nan();
-    }
-    if (a < 0.5f) {
+        r = (x == x) ? sg_nan() : (x + x);
+    } else if (a < 0.5f) {
         if (a < 0x1p-12f) {
-            return x; /* asin x rounds to x; keeps -0 */
+            r = x; /* asin x rounds to x; keeps -0 */
+        } else {
+            r = x + sg_asin_tail(x, x * x);
         }
-        return x + sg_asin_tail(x, x * x);
+    } else {
+        float z = (1.0f - a) * 0.5f;
+        float s = __builtin_sqrtf(z);
+        float u = (2.0f * sg_asin_tail(s, z)) - SG_PIO2_LO;
+        float y = (s >= 0.3125f) ? ((SG_PIO2_HI - (2.0f * s)) - u) : (SG_PIO2_HI - ((2.0f * s) + u));
+        r = (x < 0.0f) ? -y : y;
     }
-    float z = (1.0f - a) * 0.5f;
-    float s = __builtin_sqrtf(z);
-    float u = 2.0f * sg_asin_tail(s, z) - SG_PIO2_LO;
-    float y = s >= 0.3125f ? (SG_PIO2_HI - 2.0f * s) - u : SG_PIO2_HI - (2.0f * s + u);
-    return x < 0.0f ? -y : y;
+    return r;
 }
 
 /* atan(q) on 0 <= q <= 1: q + q z (b3 + b5 z + ... + b19 z^8), z = q^2. */
@@ -431,15 +443,15 @@ static float sg_atan_kernel(float q)
 {
     float z = q * q;
     float p = -0x1.d32dacp-10f;
-    p = p * z + 0x1.6410e4p-7f;
-    p = p * z - 0x1.fd6fbcp-6f;
-    p = p * z + 0x1.da24cap-5f;
-    p = p * z - 0x1.580814p-4f;
-    p = p * z + 0x1.c08c1ap-4f;
-    p = p * z - 0x1.242084p-3f;
-    p = p * z + 0x1.9991e4p-3f;
-    p = p * z - 0x1.55553ep-2f;
-    return q + q * (z * p);
+    p = (p * z) + 0x1.6410e4p-7f;
+    p = (p * z) - 0x1.fd6fbcp-6f;
+    p = (p * z) + 0x1.da24cap-5f;
+    p = (p * z) - 0x1.580814p-4f;
+    p = (p * z) + 0x1.c08c1ap-4f;
+    p = (p * z) - 0x1.242084p-3f;
+    p = (p * z) + 0x1.9991e4p-3f;
+    p = (p * z) - 0x1.55553ep-2f;
+    return q + (q * (z * p));
 }
 
 /* Annex F cases: a zero, an infinity or a NaN among the arguments (a = |y|, b = |x|). */
@@ -447,17 +459,17 @@ static float sg_atan2_special(float y, float x, float a, float b, uint32_t xneg)
 {
     float inf = sg_inf();
     float t;
-    if (x != x || y != y) {
+    if ((x != x) || (y != y)) {
         return x + y;
     }
     if (a == inf) {
-        t = b == inf ? (xneg ? 0x1.2d97c8p+1f : 0x1.921fb6p-1f) : SG_PIO2_HI;
-    } else if (b == inf || a == 0.0f) {
-        t = xneg ? SG_PI_HI : 0.0f;
+        t = (b == inf) ? ((xneg != 0u) ? 0x1.2d97c8p+1f : 0x1.921fb6p-1f) : SG_PIO2_HI;
+    } else if ((b == inf) || (a == 0.0f)) {
+        t = (xneg != 0u) ? SG_PI_HI : 0.0f;
     } else {
         t = SG_PIO2_HI; /* b == 0, a finite non-zero */
     }
-    return (sg_as_u32(y) >> 31) ? -t : t;
+    return ((sg_as_u32(y) >> 31) != 0u) ? -t : t;
 }
 
 /*
@@ -470,16 +482,19 @@ float sg_atan2f(float y, float x)
     float b = __builtin_fabsf(x);
     uint32_t xneg = sg_as_u32(x) >> 31;
     float inf = sg_inf();
-    if (__builtin_expect(!(a > 0.0f && a < inf && b > 0.0f && b < inf), 0)) {
-        return sg_atan2_special(y, x, a, b, xneg);
+    float r;
+    if (__builtin_expect(((a > 0.0f) && (a < inf) && (b > 0.0f) && (b < inf)), 1) == 0) {
+        r = sg_atan2_special(y, x, a, b, xneg);
+    } else {
+        _Bool swap = (a > b);
+        float k = sg_atan_kernel((swap ? b : a) / (swap ? a : b));
+        float t = swap ? (SG_PIO2_HI + (SG_PIO2_LO - k)) : k;
+        if (xneg != 0u) {
+            t = SG_PI_HI + (SG_PI_LO - t);
+        }
+        r = ((sg_as_u32(y) >> 31) != 0u) ? -t : t;
     }
-    int swap = a > b;
-    float k = sg_atan_kernel((swap ? b : a) / (swap ? a : b));
-    float t = swap ? SG_PIO2_HI + (SG_PIO2_LO - k) : k;
-    if (xneg != 0u) {
-        t = SG_PI_HI + (SG_PI_LO - t);
-    }
-    return (sg_as_u32(y) >> 31) ? -t : t;
+    return r;
 }
 
 /* ------------------------------------------------------------------ sqrt, pow */
@@ -584,7 +599,7 @@ const float sg_logf_tab_rows[SG_POWF_TAB_N][3] = {
 
 float sg_powf_pos(float x, float y)
 {
-    if (y == 0.0f || x == 1.0f) {
+    if ((y == 0.0f) || (x == 1.0f)) {
         return 1.0f;
     }
     if (x < 0.0f) {
@@ -596,13 +611,14 @@ float sg_powf_pos(float x, float y)
 uint32_t sg_crc32(const void *data, uint32_t bytes, uint32_t crc)
 {
     const unsigned char *p = (const unsigned char *)data;
-    uint32_t i, k;
-    crc = ~crc;
+    uint32_t c = ~crc;
+    uint32_t i;
+    uint32_t k;
     for (i = 0u; i < bytes; ++i) {
-        crc ^= (uint32_t)p[i];
+        c ^= (uint32_t)p[i];
         for (k = 0u; k < 8u; ++k) {
-            crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+            c = (c >> 1) ^ (0xEDB88320u & (0u - (c & 1u)));
         }
     }
-    return ~crc;
+    return ~c;
 }

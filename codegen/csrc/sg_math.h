@@ -77,6 +77,15 @@ float sg_tanhf(float x);
 #define SG_TANH_FIRST ((127u - 12u) << SG_TANH_M) /* index of [2^-12, 1.125 * 2^-12) */
 #define SG_TANH_N 121u                            /* intervals; the last is [8, 9) */
 #define SG_TANH_COLS 6u                           /* c, c0 .. c4 */
+/* d = (ux << 1) - SG_TANH_D_FIRST: the magnitude bits of x (2 per ulp) above those of 2^-12. The
+ * interval is d >> SG_TANH_SHIFT (= sg_tanh_index(ux)); d >= SG_TANH_D_END outside [2^-12, 9),
+ * d > SG_TANH_D_INF for NaN and for |x| < 2^-12 (d wraps around). Written out as 32-bit
+ * constants (an unsigned constant expression's essential type is its smallest type, so
+ * SG_TANH_FIRST << SG_TANH_SHIFT would shift a 16-bit value by 21: MISRA C:2012 12.2). */
+#define SG_TANH_SHIFT (24u - SG_TANH_M)
+#define SG_TANH_D_FIRST 0x73000000u /* SG_TANH_FIRST << SG_TANH_SHIFT = (127 - 12) << 24 */
+#define SG_TANH_D_END 0x0f200000u   /* SG_TANH_N << SG_TANH_SHIFT = 121 << 21 */
+#define SG_TANH_D_INF 0x8c000000u   /* 0xff000000 - SG_TANH_D_FIRST: d of +-Inf */
 extern const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS];
 
 typedef union {
@@ -95,28 +104,37 @@ static inline uint32_t sg_tanh_index(uint32_t ux)
  * sign of x. The six coefficients are loaded as one group (6 VLDR: 7 cycles, not 12). */
 static inline float sg_tanh_poly(const float *row, float x, uint32_t ux)
 {
-    const float c = row[0], c0 = row[1], c1 = row[2], c2 = row[3], c3 = row[4], c4 = row[5];
-    float t, p;
+    const float c = row[0];
+    const float c0 = row[1];
+    const float c1 = row[2];
+    const float c2 = row[3];
+    const float c3 = row[4];
+    const float c4 = row[5];
+    float t;
+    float p;
     SG_LOADS_DONE();
     t = __builtin_fabsf(x) - c;
     p = c4;
-    p = p * t + c3;
-    p = p * t + c2;
-    p = p * t + c1;
-    p = p * t + c0;
-    return (ux >> 31) ? -p : p;
+    p = (p * t) + c3;
+    p = (p * t) + c2;
+    p = (p * t) + c1;
+    p = (p * t) + c0;
+    return ((ux >> 31) != 0u) ? -p : p;
 }
 
 static inline float sg_inline_tanhf(float x)
 {
     sg_bits_t b;
     uint32_t i;
+    float r;
     b.f = x;
     i = sg_tanh_index(b.u);
     if (__builtin_expect(i >= SG_TANH_N, 0) != 0) {
-        return sg_tanhf(x);
+        r = sg_tanhf(x);
+    } else {
+        r = sg_tanh_poly(sg_tanh_tab[i], x, b.u);
     }
-    return sg_tanh_poly(sg_tanh_tab[i], x, b.u);
+    return r;
 }
 
 /* sg_tanhf with every argument class inline (no call at all), the same bits: inside [2^-12, 9)
@@ -128,11 +146,11 @@ static inline float sg_inline_tanhf_full(float x)
     sg_bits_t b;
     uint32_t d;
     b.f = x;
-    d = (b.u << 1) - (SG_TANH_FIRST << (24u - SG_TANH_M));
-    if (__builtin_expect(d < (SG_TANH_N << (24u - SG_TANH_M)), 1)) {
-        return sg_tanh_poly(sg_tanh_tab[d >> (24u - SG_TANH_M)], x, b.u);
+    d = (b.u << 1) - SG_TANH_D_FIRST;
+    if (__builtin_expect(d < SG_TANH_D_END, 1) != 0) {
+        return sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, b.u);
     }
-    if (d > 0xff000000u - (SG_TANH_FIRST << (24u - SG_TANH_M))) {
+    if (d > SG_TANH_D_INF) {
         return x;
     }
     b.u = (b.u & 0x80000000u) | 0x3f800000u;
@@ -186,60 +204,91 @@ extern const float sg_powf_fused_tab[14];
 
 static SG_ALWAYS_INLINE float sg_powf_fused(float x, float y)
 {
-    sg_bits_t bx, by, bt;
-    uint32_t ix;
-    float kf, f, p, lm, yh, yl, th, tl, t, nf, r, q;
+    sg_bits_t bx;
+    float result;
     bx.f = x;
-    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
-        return sg_powf_pos(x, y); /* not a positive normal finite float */
+    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+        result = sg_powf_pos(x, y); /* not a positive normal finite float */
+    } else {
+        sg_bits_t by;
+        uint32_t ix;
+        int32_t k;
+        float kf;
+        float f;
+        float p;
+        float lm;
+        float yh;
+        float yl;
+        float th;
+        float tl;
+        float t;
+        ix = bx.u + (0x3f800000u - 0x3f3504f3u);
+        k = (int32_t)(ix >> 23) - 127;
+        kf = (float)k;
+        bx.u = (ix & 0x007fffffu) + 0x3f3504f3u;
+        f = bx.f - 1.0f;
+        {
+            const float *c = sg_powf_fused_tab;
+            const float c7 = c[0];
+            const float c6 = c[1];
+            const float c5 = c[2];
+            const float c4 = c[3];
+            const float c3 = c[4];
+            const float c2 = c[5];
+            const float c1 = c[6];
+            const float c0 = c[7];
+            SG_LOADS_DONE();
+            p = c7;
+            p = (p * f) + c6;
+            p = (p * f) + c5;
+            p = (p * f) + c4;
+            p = (p * f) + c3;
+            p = (p * f) + c2;
+            p = (p * f) + c1;
+            p = (p * f) + c0;
+        }
+        lm = f * p;
+        by.f = y;
+        by.u &= 0xfffff000u;
+        yh = by.f;
+        yl = y - yh;
+        th = yh * kf;
+        tl = (yl * kf) + (y * lm);
+        t = th + tl;
+        /* |y| <= 31/32 implies |t| <= 124 for every normal x: with such a constant y (the tanh law's)
+         * the compiler drops the test on t; the fast-path set is the same either way. */
+        if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < SG_POWF_FUSED_MAX_T), 0) != 0) {
+            result = sg_powf_pos(x, y);
+        } else {
+            sg_bits_t bt;
+            float nf;
+            float r;
+            float q;
+            bt.f = t + 0x1.8p+23f;
+            nf = bt.f - 0x1.8p+23f;
+            r = (th - nf) + tl;
+            {
+                const float *e = &sg_powf_fused_tab[8];
+                const float e5 = e[0];
+                const float e4 = e[1];
+                const float e3 = e[2];
+                const float e2 = e[3];
+                const float e1 = e[4];
+                const float e0 = e[5];
+                SG_LOADS_DONE();
+                q = e5;
+                q = (q * r) + e4;
+                q = (q * r) + e3;
+                q = (q * r) + e2;
+                q = (q * r) + e1;
+                q = (q * r) + e0;
+            }
+            bx.f = 1.0f + (r * q);
+            bx.u += bt.u << 23;
+            result = bx.f;
+        }
     }
-    ix = bx.u + (0x3f800000u - 0x3f3504f3u);
-    kf = (float)((int32_t)(ix >> 23) - 127);
-    bx.u = (ix & 0x007fffffu) + 0x3f3504f3u;
-    f = bx.f - 1.0f;
-    {
-        const float *c = sg_powf_fused_tab;
-        const float c7 = c[0], c6 = c[1], c5 = c[2], c4 = c[3], c3 = c[4], c2 = c[5], c1 = c[6], c0 = c[7];
-        SG_LOADS_DONE();
-        p = c7;
-        p = p * f + c6;
-        p = p * f + c5;
-        p = p * f + c4;
-        p = p * f + c3;
-        p = p * f + c2;
-        p = p * f + c1;
-        p = p * f + c0;
-    }
-    lm = f * p;
-    by.f = y;
-    by.u &= 0xfffff000u;
-    yh = by.f;
-    yl = y - yh;
-    th = yh * kf;
-    tl = yl * kf + y * lm;
-    t = th + tl;
-    /* |y| <= 31/32 implies |t| <= 124 for every normal x: with such a constant y (the tanh law's)
-     * the compiler drops the test on t; the fast-path set is the same either way. */
-    if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < SG_POWF_FUSED_MAX_T), 0) != 0) {
-        return sg_powf_pos(x, y);
-    }
-    bt.f = t + 0x1.8p+23f;
-    nf = bt.f - 0x1.8p+23f;
-    r = (th - nf) + tl;
-    {
-        const float *e = sg_powf_fused_tab + 8;
-        const float e5 = e[0], e4 = e[1], e3 = e[2], e2 = e[3], e1 = e[4], e0 = e[5];
-        SG_LOADS_DONE();
-        q = e5;
-        q = q * r + e4;
-        q = q * r + e3;
-        q = q * r + e2;
-        q = q * r + e1;
-        q = q * r + e0;
-    }
-    bx.f = 1.0f + r * q;
-    bx.u += bt.u << 23;
-    return bx.f;
+    return result;
 }
 
 /* ---- sg_powf_tab: sg_powf_fused's domain, table-driven (fewer loads and multiplies) ------
@@ -260,49 +309,75 @@ extern const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N]; /* bits of 2^(j/32) */
 
 static SG_ALWAYS_INLINE float sg_powf_tab(float x, float y)
 {
-    sg_bits_t bx, by, bt;
-    uint32_t ix;
-    float kf, z, r, lz, y32, yh, yl, th, tl, t, nf, u, q;
-    const float *row;
+    sg_bits_t bx;
+    float result;
     bx.f = x;
-    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
-        return sg_powf_pos(x, y); /* not a positive normal finite float */
+    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+        result = sg_powf_pos(x, y); /* not a positive normal finite float */
+    } else {
+        sg_bits_t by;
+        uint32_t ix;
+        int32_t k;
+        float kf;
+        float z;
+        float lz;
+        float y32;
+        float yh;
+        float yl;
+        float th;
+        float tl;
+        float t;
+        const float *row;
+        ix = bx.u + (0x3f800000u - 0x3f330000u);
+        k = (int32_t)(ix >> 23) - 127;
+        kf = (float)k;
+        row = sg_powf_tab_log[(ix >> 18) & 31u];
+        bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+        z = bx.f;
+        {
+            const float c = row[0];
+            const float ic = row[1];
+            const float lc = row[2];
+            const float a0 = sg_powf_tab_poly[0];
+            const float a1 = sg_powf_tab_poly[1];
+            const float a2 = sg_powf_tab_poly[2];
+            float r;
+            SG_LOADS_DONE();
+            r = (z - c) * ic;
+            lz = lc + (r * ((((a2 * r) + a1) * r) + a0));
+        }
+        y32 = 32.0f * y;
+        by.f = y32;
+        by.u &= 0xfffff000u;
+        yh = by.f;
+        yl = y32 - yh;
+        th = yh * kf;
+        tl = (yl * kf) + (y32 * lz);
+        t = th + tl;
+        /* |y| <= 31/32 implies |t| <= 32 * 124 for every normal x: the test on t folds away for
+         * such a constant y; the fast-path set is the same either way. */
+        if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < (32.0f * SG_POWF_FUSED_MAX_T)), 0) != 0) {
+            result = sg_powf_pos(x, y);
+        } else {
+            sg_bits_t bt;
+            float nf;
+            float u;
+            float q;
+            bt.f = t + 0x1.8p+23f;
+            nf = bt.f - 0x1.8p+23f;
+            u = (th - nf) + tl;
+            {
+                const float b0 = sg_powf_tab_poly[3];
+                const float b1 = sg_powf_tab_poly[4];
+                const float b2 = sg_powf_tab_poly[5];
+                SG_LOADS_DONE();
+                q = u * ((((b2 * u) + b1) * u) + b0);
+            }
+            bx.u = sg_powf_tab_exp2[bt.u & 31u] + ((bt.u >> 5) << 23);
+            result = bx.f + (bx.f * q);
+        }
     }
-    ix = bx.u + (0x3f800000u - 0x3f330000u);
-    kf = (float)((int32_t)(ix >> 23) - 127);
-    row = sg_powf_tab_log[(ix >> 18) & 31u];
-    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
-    z = bx.f;
-    {
-        const float c = row[0], ic = row[1], lc = row[2];
-        const float a0 = sg_powf_tab_poly[0], a1 = sg_powf_tab_poly[1], a2 = sg_powf_tab_poly[2];
-        SG_LOADS_DONE();
-        r = (z - c) * ic;
-        lz = lc + r * ((a2 * r + a1) * r + a0);
-    }
-    y32 = 32.0f * y;
-    by.f = y32;
-    by.u &= 0xfffff000u;
-    yh = by.f;
-    yl = y32 - yh;
-    th = yh * kf;
-    tl = yl * kf + y32 * lz;
-    t = th + tl;
-    /* |y| <= 31/32 implies |t| <= 32 * 124 for every normal x: the test on t folds away for
-     * such a constant y; the fast-path set is the same either way. */
-    if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < 32.0f * SG_POWF_FUSED_MAX_T), 0)) {
-        return sg_powf_pos(x, y);
-    }
-    bt.f = t + 0x1.8p+23f;
-    nf = bt.f - 0x1.8p+23f;
-    u = (th - nf) + tl;
-    {
-        const float b0 = sg_powf_tab_poly[3], b1 = sg_powf_tab_poly[4], b2 = sg_powf_tab_poly[5];
-        SG_LOADS_DONE();
-        q = u * ((b2 * u + b1) * u + b0);
-    }
-    bx.u = sg_powf_tab_exp2[bt.u & 31u] + ((bt.u >> 5) << 23);
-    return bx.f + bx.f * q;
+    return result;
 }
 
 /* ---- sg_powf_const: x^y for an exponent fixed at generation time -----------------------
@@ -328,31 +403,44 @@ typedef struct {
 static SG_ALWAYS_INLINE float sg_powf_const(float x, const sg_powc_t *t)
 {
     sg_bits_t bx;
-    uint32_t ix;
-    float z, r, q, s;
-    const float *row;
+    float result;
     bx.f = x;
-    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
-        if (t->y > 0.0f && bx.u < 0x00800000u) {
-            return 0.0f; /* +0 or subnormal x, y > 0: +0 (exact at 0, below 2^(-126 y) otherwise) */
+    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+        if ((t->y > 0.0f) && (bx.u < 0x00800000u)) {
+            result = 0.0f; /* +0 or subnormal x, y > 0: +0 (exact at 0, below 2^(-126 y) otherwise) */
+        } else {
+            result = sg_powf_pos(x, t->y); /* -0, negative, +Inf, NaN; y < 0 at +0 or subnormal x */
         }
-        return sg_powf_pos(x, t->y); /* -0, negative, +Inf, NaN; y < 0 at +0 or subnormal x */
+    } else {
+        uint32_t ix;
+        float z;
+        float q;
+        float s;
+        const float *row;
+        ix = bx.u + (0x3f800000u - 0x3f330000u);
+        row = t->row[(ix >> 18) & 31u];
+        /* (ix & 0x7fffff) + 0x3f330000, written so that the constant is one Thumb-2 immediate */
+        bx.u = (bx.u + 0x3f800000u) - ((ix >> 23) << 23);
+        z = bx.f;
+        {
+            const float c = row[0];
+            const float ic = row[1];
+            const float cy = row[2];
+            const float ek = t->ek[(ix >> 23) - 1u];
+            float p0 = t->p[0];
+            float p1 = t->p[1];
+            float p2 = t->p[2];
+            float p3 = t->p[3];
+            float r;
+            SG_IN_REGS4(p0, p1, p2, p3); /* the four coefficient loads issued together */
+            SG_LOADS_DONE();
+            r = (z - c) * ic;
+            q = r * ((((((p3 * r) + p2) * r) + p1) * r) + p0);
+            s = cy * ek;
+        }
+        result = s + (s * q);
     }
-    ix = bx.u + (0x3f800000u - 0x3f330000u);
-    row = t->row[(ix >> 18) & 31u];
-    /* (ix & 0x7fffff) + 0x3f330000, written so that the constant is one Thumb-2 immediate */
-    bx.u = (bx.u + 0x3f800000u) - ((ix >> 23) << 23);
-    z = bx.f;
-    {
-        const float c = row[0], ic = row[1], cy = row[2], ek = t->ek[(ix >> 23) - 1u];
-        float p0 = t->p[0], p1 = t->p[1], p2 = t->p[2], p3 = t->p[3];
-        SG_IN_REGS4(p0, p1, p2, p3); /* the four coefficient loads issued together */
-        SG_LOADS_DONE();
-        r = (z - c) * ic;
-        q = r * (((p3 * r + p2) * r + p1) * r + p0);
-        s = cy * ek;
-    }
-    return s + s * q;
+    return result;
 }
 
 /* ---- sg_logf_tab: ln x, table-driven, inline --------------------------------------------
@@ -366,25 +454,35 @@ extern const float sg_logf_tab_rows[SG_POWF_TAB_N][3]; /* c, 1/c, ln c */
 static SG_ALWAYS_INLINE float sg_logf_tab(float x)
 {
     sg_bits_t bx;
-    uint32_t ix;
-    float kf, z, r, lz;
-    const float *row;
+    float result;
     bx.f = x;
-    if (__builtin_expect(bx.u - 0x00800000u >= 0x7f000000u, 0)) {
-        return sg_logf(x); /* not a positive normal finite float */
+    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+        result = sg_logf(x); /* not a positive normal finite float */
+    } else {
+        uint32_t ix;
+        int32_t k;
+        float kf;
+        float z;
+        float lz;
+        const float *row;
+        ix = bx.u + (0x3f800000u - 0x3f330000u);
+        k = (int32_t)(ix >> 23) - 127;
+        kf = (float)k;
+        row = sg_logf_tab_rows[(ix >> 18) & 31u];
+        bx.u = (ix & 0x007fffffu) + 0x3f330000u;
+        z = bx.f;
+        {
+            const float c = row[0];
+            const float ic = row[1];
+            const float lc = row[2];
+            float r;
+            SG_LOADS_DONE();
+            r = (z - c) * ic;
+            lz = lc + (r * ((((((((0x1.99999ap-3f * r) - 0x1.0p-2f) * r) + 0x1.555556p-2f) * r) - 0x1.0p-1f) * r) + 1.0f));
+        }
+        result = (kf * 0x1.62e4p-1f) + ((kf * 0x1.7f7d1cp-20f) + lz);
     }
-    ix = bx.u + (0x3f800000u - 0x3f330000u);
-    kf = (float)((int32_t)(ix >> 23) - 127);
-    row = sg_logf_tab_rows[(ix >> 18) & 31u];
-    bx.u = (ix & 0x007fffffu) + 0x3f330000u;
-    z = bx.f;
-    {
-        const float c = row[0], ic = row[1], lc = row[2];
-        SG_LOADS_DONE();
-        r = (z - c) * ic;
-        lz = lc + r * (((((0x1.99999ap-3f * r - 0x1.0p-2f) * r + 0x1.555556p-2f) * r - 0x1.0p-1f) * r) + 1.0f);
-    }
-    return kf * 0x1.62e4p-1f + (kf * 0x1.7f7d1cp-20f + lz);
+    return result;
 }
 
 /* CRC-32 (IEEE 802.3, reflected, poly 0xEDB88320) of `bytes` bytes, continuing from `crc`
