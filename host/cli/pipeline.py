@@ -5,7 +5,8 @@ samples on Dask (<out>/samples/, the `regularised` objective); training of the 1
 network on them (<out>/network.json, <out>/training.md); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
 ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); the
 flight package of the whole Fig. 2 controller with the default configuration (<out>/package,
-<out>/controller.toml); a report (report.json, report.txt). The output folder is built atomically: a failed stage leaves
+<out>/controller.toml); small presets of PID tuning (<out>/tune), evaluation (<out>/evaluate) and
+their report (<out>/report/report.md, report.html); a summary (report.json, report.txt). The output folder is built atomically: a failed stage leaves
 no partial folder.
 """
 from __future__ import annotations
@@ -169,13 +170,73 @@ def stage_package(ctx: PipelineContext) -> None:
     ctx.report.append("\n".join(lines))
 
 
+# Small presets of `staregen tune pid`, `evaluate` and `report` (the paper-scale runs are benchmarks).
+TUNE_TARGETS, TUNE_DURATION_S = 4, 20.0
+EVAL_TARGETS, EVAL_DURATION_S, EVAL_FREQS = 3, 20.0, (0.1, 1.0)
+
+
+def stage_tune(ctx: PipelineContext) -> None:
+    """The coarse PID grid over the first targets on the batched simulator (<out>/tune)."""
+    from host.cli.tune import parse_targets
+    from host.tune.pid_grid import grid
+    from host.tune.pid_tuning import TuningPlan, tune
+
+    plan = TuningPlan(grid=grid("coarse"), targets=parse_targets(str(TUNE_TARGETS)), duration=TUNE_DURATION_S)
+    doc = tune(ctx.out / "tune", plan, default_package_config(), progress=False)
+    best = {a: [doc["best"][a][k] for k in ("kp", "ki", "kd")] for a in doc["best"]}
+    ctx.results["tune"] = {"folder": "tune", "grid": "coarse", "best_kp_ki_kd": best, "check": doc["check"]}
+    ctx.report.append(f"tune pid (coarse grid, {TUNE_TARGETS} targets, {TUNE_DURATION_S:g} s): best (Kp, Ki, Kd) "
+                      f"x {best['x']}, y {best['y']}, z {best['z']}; check run J-bar Table 1 "
+                      f"{doc['check']['table1']['J']:.3e}, tuned {doc['check']['tuned']['J']:.3e}")
+
+
+def stage_evaluate(ctx: PipelineContext) -> None:
+    """NN (float64, SIL, PIL on the central target), Table 1 and tuned PID, PD+FF: staring, step,
+    frequency and impulse responses on a small preset (<out>/evaluate), then the report (<out>/report)."""
+    from host.cli.evaluate import summary
+    from host.cli.tune import parse_targets
+    from host.sim import impulse
+    from host.tune import figures
+    from host.tune.evaluate import ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
+    from host.tune.report import write_report
+
+    targets = parse_targets(str(EVAL_TARGETS))
+    c = central_target()
+    plan = EvalPlan(targets=targets, response_targets=targets[:1], central=(c.name, c.lon, c.lat, 0),
+                    duration=EVAL_DURATION_S, freqs=EVAL_FREQS, freq_duration=30.0)
+    tuned = pc.load(ctx.out / "tune" / "controller.toml").controller
+    net, laws = str(ctx.out / "network.json"), str(ctx.out / "network.baselines.json")
+    specs = [table1_spec(), tuned_spec(tuned.kp, tuned.ki, tuned.kd),
+             ControllerSpec("NN (float64)", "nn", (("artifact", net),)),
+             ControllerSpec("NN (SIL, x86 C)", "nn-c", (("artifact", net),)),
+             ControllerSpec("NN (PIL, ARM, central)", "nn-arm", (("artifact", net),)),
+             ControllerSpec("PD+FF", "pdff", (("baselines", laws),))]
+    result = evaluate(plan, specs, progress=False)
+    imp = impulse.run("nn", net, seed=PRESET_SEED)
+    result["impulse"] = imp.as_dict()
+    folder = ctx.out / "evaluate"
+    folder.mkdir()
+    figures.fig10_scatter(result["staring"], folder / "fig10_scatter.png")
+    figures.fig11_12_step(result["step"], folder / "fig11_12_step.png")
+    figures.fig13_14_frequency(result["frequency"], folder / "fig13_14_frequency.png")
+    impulse.plot(imp, folder / "fig15_impulse.png", "NN (float64)")
+    atomic.write_json(folder / "evaluate.json", result)
+    write_report(ctx.out / "report", folder, ctx.out / "tune", ["staregen pipeline (small presets of tune pid, "
+                                                               "evaluate and report)"])
+    ctx.results["evaluate"] = {"folder": "evaluate", "report": "report/report.html",
+                               "staring": {k: {m: v[m] for m in ("J_A", "J_w", "J", "targets")}
+                                           for k, v in result["staring"].items()}}
+    ctx.report.append(f"evaluate ({EVAL_TARGETS} targets, {EVAL_DURATION_S:g} s; report in "
+                      f"{ctx.final / 'report' / 'report.html'}):\n" + summary(result))
+
+
 def stage_report(ctx: PipelineContext) -> None:
     atomic.write_json(ctx.out / "report.json", ctx.results)
     atomic.write_text(ctx.out / "report.txt", "\n\n".join(ctx.report) + "\n")
 
 
 STAGES = [stage_scenario, stage_pid_central, stage_samples, stage_train, stage_codegen, stage_gate, stage_cycles,
-          stage_package, stage_report]
+          stage_package, stage_tune, stage_evaluate, stage_report]
 # The package's evidence at pipeline scale (the standalone `staregen generate` defaults measure more).
 PACKAGE_PLAN = EvidencePlan(gate_vectors=20_000, gate_sequences=4, sequence_steps=200, selftest_vectors=256,
                             cycles_per_class=20, seed=PRESET_SEED)
