@@ -47,6 +47,6 @@ def test_an_out_of_bounds_write_is_a_sanitizer_report():
 
 
 def test_a_changed_operation_is_a_mismatch():
-    unit = Planted(ARTIFACT, "    y[0] = sg_canonf((yn0 - ", "    y[0] = sg_canonf((yn0 + ")
+    unit = Planted(ARTIFACT, "    y[0] = sg_canonf(((yn0 - ", "    y[0] = sg_canonf(((yn0 + ")
     result = fuzz(unit, 2000, log=lambda _: None)
     assert result.mismatches > 0 and not result.ok

@@ -60,7 +60,10 @@ def test_kp_from_the_file_reaches_c_golden_and_twin(tmp_path):
         results.append((golden, np.array(torques), np.array(angles)))
     (g1, t1, a1), (g2, t2, _) = results
     pid = (g1["status"] & cs.STATUS_PID != 0) & (g2["status"] & cs.STATUS_PID != 0)
-    free = pid & (np.abs(g1["torque"][:, AXIS]) < 0.9) & (np.abs(g2["torque"][:, AXIS]) < 0.9)
+    # the bound class also flies 90° roll errors (the asin clamp's rows): at gimbal lock the 3-1-2
+    # pitch and yaw are ill-conditioned and float32 and float64 part ways by design; leave them out
+    upright = np.abs(g1["A_bd"][:, 0].astype(float)) < math.radians(10.0)
+    free = pid & upright & (np.abs(g1["torque"][:, AXIS]) < 0.9) & (np.abs(g2["torque"][:, AXIS]) < 0.9)
     assert free.sum() >= 10, free.sum()
     # the other axes do not move; the edited axis moves by ΔKp·A_bd (degrees), in float32 and float64
     others = [k for k in range(3) if k != AXIS]
