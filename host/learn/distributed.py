@@ -32,6 +32,7 @@ def default_workers() -> int:
 def dask_client(scheduler: str | None = None, workers: int | None = None,
                 connect_timeout: float = DEFAULT_CONNECT_TIMEOUT, processes: bool = True) -> Iterator:
     """A distributed.Client: on `scheduler` (tcp://host:port) or on a new LocalCluster."""
+    import dask
     from distributed import Client, LocalCluster
 
     if scheduler is not None and workers is not None:
@@ -51,9 +52,15 @@ def dask_client(scheduler: str | None = None, workers: int | None = None,
             client.close()
         return
     # No dashboard (nothing to show in a batch run); its HTTP server on a free port, not a fixed one.
-    cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=processes,
-                           dashboard_address=":0", scheduler_kwargs={"dashboard": False},
-                           silence_logs=logging.ERROR)
+    # Without Dask's MALLOC_TRIM_THRESHOLD_: an explicit glibc trim threshold switches off the dynamic
+    # mmap threshold, so every numpy temporary over 128 KiB is mmap'd and unmapped again; measured,
+    # the batched simulator runs 3.4x slower in such a worker (62 vs 212 scenarios/s).
+    environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+               if k != "MALLOC_TRIM_THRESHOLD_"}
+    with dask.config.set({"distributed.nanny.pre-spawn-environ": environ}):
+        cluster = LocalCluster(n_workers=workers or default_workers(), threads_per_worker=1, processes=processes,
+                               dashboard_address=":0", scheduler_kwargs={"dashboard": False},
+                               silence_logs=logging.ERROR)
     client = Client(cluster)
     try:
         yield client
