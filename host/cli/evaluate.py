@@ -19,7 +19,9 @@ from host.control.baselines import load_baselines
 from host.errors import HostError
 from host.learn.training import baselines_path
 from host.sim import impulse
-from host.sim.targets import central_target
+from host.sim.campaign import check_targets_visible
+from host.sim.simulator import SimConfig
+from host.sim.targets import Target, central_target
 from host.tune import figures
 from host.tune.evaluate import ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
 
@@ -31,7 +33,8 @@ def register(subparsers) -> None:
     p.add_argument("--baselines", default=None, metavar="FILE",
                    help="fitted baselines (default: <network>.baselines.json when it exists)")
     p.add_argument("--tuned", default=None, metavar="FILE", help="controller.toml with tuned PID gains")
-    p.add_argument("--targets", default="all", help="staring targets: all, central or N (the first N of the 100)")
+    p.add_argument("--targets", default="all",
+                   help="staring targets: all, central, N (the first N of the 100) or a target list file")
     p.add_argument("--response-targets", default="10", help="targets averaged in the step response (default 10)")
     p.add_argument("--duration", default="100", help="staring run length in s (default 100)")
     p.add_argument("--freqs", default="0.02,0.05,0.1,0.2,0.5,1,2,3,4.5", help="frequency grid in Hz")
@@ -79,6 +82,7 @@ def run(args: argparse.Namespace) -> int:
                     duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
                     seed=parse_int(args.seed, "--seed", maximum=2**32 - 1), freqs=parse_freqs(args.freqs))
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1, maximum=256)
+    check_targets_visible([Target(n, lon, lat) for n, lon, lat, _ in targets], SimConfig(duration=plan.duration))
     specs = controller_specs(args)
     out = Path(args.out)
     if out.exists() and not out.is_dir():

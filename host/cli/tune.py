@@ -3,7 +3,8 @@ simulator (Dask: a local cluster or --scheduler), sharded and resumable; the bes
 goes into a controller configuration (OUT/controller.toml) that `staregen generate` flies.
 
   --grid coarse|table7   60 triples (CI, the pipeline) or the paper's 12,240 (docs: host/tune/pid_grid.py)
-  --targets all|central|N   the 100 staring targets, the central one, or the first N of the 100
+  --targets all|central|N|FILE   the 100 staring targets, the central one, the first N of the 100, or a
+                        target list file (NAME,LON,LAT or LON,LAT per line, degrees)
 """
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ from codegen.package import config as pc
 from host.cli.args import parse_int, parse_number
 from host.control.nn_controller import default_package_config
 from host.errors import HostError
-from host.sim.targets import central_target, staring_targets
+from host.sim.campaign import check_targets_visible
+from host.sim.targets import Target, central_target, load_target_list, staring_targets
 from host.tune.pid_grid import GRIDS, grid
 from host.tune.pid_tuning import AXES, TuningPlan, tune
 
@@ -40,13 +42,16 @@ def register(subparsers) -> None:
 
 def parse_targets(text: str) -> tuple[tuple[str, float, float, int], ...]:
     """(name, lon, lat, noise stream): a target's stream is its index among the 100, as in
-    `staregen simulate --target all`; the central target flies stream 0 as `--target central` does."""
+    `staregen simulate --target all`; the central target flies stream 0 as `--target central` does;
+    a target list file (NAME,LON,LAT or LON,LAT per line, degrees) gives row i stream i."""
+    if Path(text).is_file():
+        return tuple((t.name, t.lon, t.lat, i) for i, t in enumerate(load_target_list(text)))
     key = text.strip().lower()
     if key == "central":
         c = central_target()
         return ((c.name, c.lon, c.lat, 0),)
     every = staring_targets()
-    n = len(every) if key == "all" else parse_int(text, "--targets (all, central or a count)", minimum=1,
+    n = len(every) if key == "all" else parse_int(text, "--targets (all, central, a count or a file)", minimum=1,
                                                   maximum=len(every))
     return tuple((t.name, t.lon, t.lat, i) for i, t in enumerate(every[:n]))
 
@@ -65,6 +70,7 @@ def run_pid(args: argparse.Namespace) -> int:
     plan = TuningPlan(grid=grid(args.grid), targets=parse_targets(args.targets), seeds=parse_seeds(args.seeds),
                       duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
                       shard_size=parse_int(args.shard_size, "--shard-size", minimum=1, maximum=100_000))
+    check_targets_visible([Target(n, lon, lat) for n, lon, lat, _ in plan.targets], plan.sim_config())
     base = pc.load(args.config) if args.config else default_package_config()
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1, maximum=256)
     out = Path(args.out)

@@ -11,6 +11,7 @@ run and machine (numpy PCG64).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from functools import lru_cache
 
 import numpy as np
@@ -102,3 +103,37 @@ def parse_target(text: str) -> list[Target]:
     if not -180.0 <= lon_deg < 360.0:
         raise HostError(f"target longitude {lon_deg:g} deg is outside [-180, 360)")
     return [Target(f"{lon_deg:g},{lat_deg:g}", lon_deg * DEG, lat_deg * DEG)]
+
+
+MAX_TARGET_ROWS = 10_000
+
+
+def load_target_list(path) -> list[Target]:
+    """A target list file: one target per line, `LON,LAT` or `NAME,LON,LAT` (degrees, geodetic);
+    blank lines and `#` comments ignored. Any bad row is a one-line HostError naming the line."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise HostError(f"{p}: cannot read the target list ({getattr(exc, 'strerror', None) or type(exc).__name__})") from None
+    targets = []
+    for number, raw in enumerate(text.splitlines(), 1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        parts = [s.strip() for s in line.split(",")]
+        if len(parts) not in (2, 3):
+            raise HostError(f"{p}:{number}: expected LON,LAT or NAME,LON,LAT in degrees, got {line[:60]!r}")
+        name = parts[0] if len(parts) == 3 else None
+        if name is not None and not (name.isprintable() and 0 < len(name) <= 40):
+            raise HostError(f"{p}:{number}: a target name must be 1-40 printable characters")
+        try:
+            (target,) = parse_target(",".join(parts[-2:]))
+        except HostError as exc:
+            raise HostError(f"{p}:{number}: {exc}") from None
+        targets.append(Target(name or target.name, target.lon, target.lat))
+        if len(targets) > MAX_TARGET_ROWS:
+            raise HostError(f"{p}: more than {MAX_TARGET_ROWS} targets")
+    if not targets:
+        raise HostError(f"{p}: no targets in the file")
+    return targets

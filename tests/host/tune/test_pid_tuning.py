@@ -158,3 +158,30 @@ def test_cli_tunes_and_resumes(tmp_path, capsys, monkeypatch):
     assert "computed 2 shard(s), kept 0" in first and "tuned configuration" in first
     assert main(argv) == 0
     assert "computed 0 shard(s), kept 2" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("rows, message", [
+    ("120,30\nfoo\n", ":2: expected LON,LAT"),
+    ("120,95\n", ":1: target latitude 95 deg"),
+    ("a,b,c\n", ":1: unknown target"),
+    ("# nothing\n\n", "no targets"),
+    ("120,nan\n", ":1: target"),
+    (",120,30\n", ":1: a target name"),
+    ("300,30\n", "below the horizon"),
+])
+def test_target_list_files_with_bad_rows_are_one_line_errors(rows, message, tmp_path, capsys):
+    path = tmp_path / "targets.csv"
+    path.write_text(rows)
+    assert main(["tune", "pid", "--targets", str(path), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err, err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_target_list_file_gives_names_and_streams(tmp_path):
+    from host.cli.tune import parse_targets
+    path = tmp_path / "t.csv"
+    path.write_text("# staring targets\nwest, 119.5, 30.1\n120.2,29.8  # unnamed\n")
+    t = parse_targets(str(path))
+    assert [(n, s) for n, _, _, s in t] == [("west", 0), ("120.2,29.8", 1)]
+    assert t[0][1] == pytest.approx(np.radians(119.5)) and t[1][2] == pytest.approx(np.radians(29.8))
