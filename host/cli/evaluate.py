@@ -39,12 +39,38 @@ def register(subparsers) -> None:
     p.add_argument("--duration", default="100", help="staring run length in s (default 100)")
     p.add_argument("--freqs", default="0.02,0.05,0.1,0.2,0.5,1,2,3,4.5", help="frequency grid in Hz")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
+    p.add_argument("--controllers", default=None,
+                   help="comma-separated subset of " + ", ".join(KEYS) + " (default: every one available)")
     p.add_argument("--sil", action="store_true", help="add the generated C (x86, cffi) over the targets")
     p.add_argument("--pil", action="store_true", help="add the generated C in the ARM emulator, central target")
     p.add_argument("--workers", default=None, help="worker processes (default: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.add_argument("--out", required=True, help="output folder (created)")
     p.set_defaults(func=run)
+
+
+# --controllers names -> labels of the specs below
+KEYS = {"pid": "PID (Table 1)", "pid-tuned": "PID (tuned)", "nn": "NN (float64)", "nn-c": "NN (SIL, x86 C)",
+        "nn-arm": "NN (PIL, ARM, central)", "pdff": "PD+FF"}
+
+
+def select(specs: list[ControllerSpec], text: str | None) -> list[ControllerSpec]:
+    """The specs named by --controllers (each must be known and available with the given inputs)."""
+    if text is None:
+        return specs
+    names = [n.strip() for n in text.split(",") if n.strip()]
+    if not names:
+        raise HostError("--controllers lists no controller")
+    for n in names:
+        if n not in KEYS:
+            raise HostError(f"unknown controller {n!r} (known: {', '.join(KEYS)})")
+    available = {s.label for s in specs}
+    missing = [n for n in names if KEYS[n] not in available]
+    if missing:
+        raise HostError(f"--controllers {', '.join(missing)}: not available with these inputs "
+                        "(pid-tuned needs --tuned, nn-c --sil, nn-arm --pil, pdff a baselines file)")
+    wanted = {KEYS[n] for n in names}
+    return [s for s in specs if s.label in wanted]
 
 
 def controller_specs(args) -> list[ControllerSpec]:
@@ -64,7 +90,7 @@ def controller_specs(args) -> list[ControllerSpec]:
     if laws:
         load_baselines(laws)
         specs.append(ControllerSpec("PD+FF", "pdff", (("baselines", laws),)))
-    return specs
+    return select(specs, args.controllers)
 
 
 def parse_freqs(text: str) -> tuple[float, ...]:

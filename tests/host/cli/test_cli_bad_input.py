@@ -135,6 +135,8 @@ CASES = [
     (["evaluate", "--network", "{net}", "--targets", "3", "--response-targets", "4", "--out", "{tmp}/e"],
      "--response-targets"),
     (["evaluate", "--network", "{net}", "--tuned", "{net}", "--out", "{tmp}/e"], "not valid TOML"),
+    (["evaluate", "--network", "{net}", "--controllers", "pid,lqr", "--out", "{tmp}/e"], "unknown controller 'lqr'"),
+    (["evaluate", "--network", "{net}", "--controllers", "nn-arm", "--out", "{tmp}/e"], "not available"),
     (["report", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"], "not a folder"),
     (["report", "--evaluate", "{dir}", "--out", "{tmp}/r"], "evaluate.json"),
 ]
