@@ -2,7 +2,7 @@
 simulator (Dask: a local cluster or --scheduler), sharded and resumable; the best triple per axis
 goes into a controller configuration (OUT/controller.toml) that `staregen generate` flies.
 
-  --grid coarse|table7   60 triples (CI, the pipeline) or the paper's 12,240 (docs: host/tune/pid_grid.py)
+  --grid coarse|table7|kp=LO:HI:STEP,ki=..,kd=..   60 triples (CI, the pipeline), the paper's 12,240, or your own
   --targets all|central|N|FILE   the 100 staring targets, the central one, the first N of the 100, or a
                         target list file (NAME,LON,LAT or LON,LAT per line, degrees)
 """
@@ -26,7 +26,8 @@ def register(subparsers) -> None:
                               description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="tune_command", required=True, metavar="CONTROLLER")
     pid = sub.add_parser("pid", help="the Table 7 PID grid, each axis optimised on its share of eq. 8")
-    pid.add_argument("--grid", default="coarse", choices=sorted(GRIDS), help="gain grid (default coarse)")
+    pid.add_argument("--grid", default="coarse",
+                     help=f"gain grid: {', '.join(sorted(GRIDS))} or kp=LO:HI:STEP,ki=...,kd=... (default coarse)")
     pid.add_argument("--targets", default="all", help="all (the 100), central, or N (the first N of the 100)")
     pid.add_argument("--duration", default="100", help="simulated seconds per run (default 100)")
     pid.add_argument("--seeds", default="0", help="noise seeds, comma separated (default 0)")

@@ -71,7 +71,49 @@ GRIDS = {
 }
 
 
-def grid(name: str) -> PidGrid:
-    if name not in GRIDS:
-        raise HostError(f"unknown grid {name!r} (known: {', '.join(sorted(GRIDS))})")
-    return GRIDS[name]
+MAX_TRIPLES = 1_000_000
+
+
+def _axis_values(key: str, spec: str) -> tuple[float, ...]:
+    """`V` or `LO:HI:STEP` (both ends included when HI lies on the step)."""
+    parts = spec.split(":")
+    try:
+        nums = [float(p) for p in parts]
+    except ValueError:
+        raise HostError(f"grid {key}={spec}: expected a number or LO:HI:STEP") from None
+    if len(nums) not in (1, 3) or not all(np.isfinite(nums)):
+        raise HostError(f"grid {key}={spec}: expected a number or LO:HI:STEP")
+    if len(nums) == 1:
+        return (nums[0],)
+    lo, hi, step = nums
+    if step <= 0:
+        raise HostError(f"grid {key}={spec}: the step must be > 0")
+    if hi < lo:
+        raise HostError(f"grid {key}={spec}: empty range (HI < LO)")
+    if (hi - lo) / step > MAX_TRIPLES:
+        raise HostError(f"grid {key}={spec}: more than {MAX_TRIPLES} values")
+    return _steps(lo, lo + step * np.floor((hi - lo) / step + 1e-9), step)
+
+
+def grid(text: str) -> PidGrid:
+    """A preset name (table7, coarse) or `kp=SPEC,ki=SPEC,kd=SPEC` with SPEC a number or LO:HI:STEP."""
+    if text in GRIDS:
+        return GRIDS[text]
+    if "=" not in text:
+        raise HostError(f"unknown grid {text!r} (known: {', '.join(sorted(GRIDS))}, or kp=LO:HI:STEP,ki=...,kd=...)")
+    specs = {}
+    for item in text.split(","):
+        key, _, spec = item.partition("=")
+        key = key.strip()
+        if key not in ("kp", "ki", "kd"):
+            raise HostError(f"grid: unknown key {key!r} (kp, ki, kd)")
+        if key in specs:
+            raise HostError(f"grid: {key} given twice")
+        specs[key] = _axis_values(key, spec.strip())
+    missing = [k for k in ("kp", "ki", "kd") if k not in specs]
+    if missing:
+        raise HostError(f"grid: missing {', '.join(missing)}")
+    g = PidGrid("custom", specs["kp"], specs["ki"], specs["kd"])
+    if len(g) > MAX_TRIPLES:
+        raise HostError(f"grid: {len(g)} triples, more than {MAX_TRIPLES}")
+    return g

@@ -140,7 +140,12 @@ def test_swapped_edited_and_foreign_shards_are_refused(tuned, tmp_path):
     (["--duration", "5"], "--duration"),
     (["--shard-size", "0"], "--shard-size"),
     (["--workers", "0"], "--workers"),
-    (["--grid", "fine"], "invalid choice"),
+    (["--grid", "fine"], "unknown grid 'fine'"),
+    (["--grid", "kp=5:1:1,ki=0,kd=40"], "empty range"),
+    (["--grid", "kp=1:5:0,ki=0,kd=40"], "step must be > 0"),
+    (["--grid", "kp=1,ki=0"], "missing kd"),
+    (["--grid", "kp=1,ki=0,kd=4,kx=1"], "unknown key 'kx'"),
+    (["--grid", "kp=1:1000000:0.001,ki=0,kd=40"], "more than"),
 ])
 def test_bad_arguments_are_one_line_errors(argv, message, tmp_path, capsys):
     assert main(["tune", "pid", "--out", str(tmp_path / "o"), *argv]) == 2
@@ -185,3 +190,10 @@ def test_a_target_list_file_gives_names_and_streams(tmp_path):
     t = parse_targets(str(path))
     assert [(n, s) for n, _, _, s in t] == [("west", 0), ("120.2,29.8", 1)]
     assert t[0][1] == pytest.approx(np.radians(119.5)) and t[1][2] == pytest.approx(np.radians(29.8))
+
+
+def test_custom_grid_spec():
+    from host.tune.pid_grid import grid
+    g = grid("kp=1:3:1,ki=0,kd=40:50:5")
+    assert (g.kp, g.ki, g.kd) == ((1.0, 2.0, 3.0), (0.0,), (40.0, 45.0, 50.0)) and len(g) == 9
+    assert grid("kp=0:0.03:0.01,ki=0,kd=1").kp == (0.0, 0.01, 0.02, 0.03)
