@@ -28,6 +28,7 @@ import numpy as np
 
 from host.errors import HostError
 from host.learn.ocp import OcpConfig, solver_for
+from host.learn.shards import check_place, read_bound_npz, read_json
 from codegen import atomic
 
 # Table 2 of paper 001, in its units (°/s, °/s², °, °/s); tests check it equals codegen's copy.
@@ -206,20 +207,13 @@ def write_shard(directory: Path, plan: DatasetPlan, result: dict) -> None:
     atomic.write_json(json_path, sidecar)
 
 
-def _read_json(path: Path, what: str) -> dict:
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise HostError(f"{path}: unreadable {what} ({type(exc).__name__})") from None
-
-
 def read_shard(directory: Path, plan: "DatasetPlan", index: int) -> tuple[dict, dict]:
     """The arrays and sidecar of a finished shard; a damaged, foreign, swapped or edited shard is a
     HostError. The sidecar is bound to its place in the dataset (index, first sample, count, seeds,
     config hash), the npz to the sidecar (size, sha256), and the content to the index: the inputs
     must be the ones the shard's seed draws, and the statistics the ones its arrays give."""
     npz_path, json_path = shard_paths(directory, index)
-    sidecar = _read_json(json_path, "shard sidecar")
+    sidecar = read_json(json_path, "shard sidecar")
     config_hash, expected_count = plan.config_hash(), plan.shard_count(index)
     if sidecar.get("config_hash") != config_hash:
         raise HostError(f"{json_path}: config hash {str(sidecar.get('config_hash'))[:12]}… does not match "
@@ -227,18 +221,8 @@ def read_shard(directory: Path, plan: "DatasetPlan", index: int) -> tuple[dict, 
     seed = shard_seed(plan.master_seed, index)
     place = {"format": SHARD_FORMAT, "shard": index, "first_sample": index * plan.shard_size,
              "n_samples": expected_count, "seed": {"master_seed": plan.master_seed, "spawn_key": list(seed.spawn_key)}}
-    for key, want in place.items():
-        if sidecar.get(key) != want:
-            raise HostError(f"{json_path}: {key} is {str(sidecar.get(key))[:40]}, shard {index} of this dataset has "
-                            f"{want} (a copied or edited sidecar); delete it and its npz to recompute the shard")
-    try:
-        data = npz_path.read_bytes()
-    except OSError:
-        raise HostError(f"{npz_path}: missing although its sidecar exists; "
-                        f"delete {json_path.name} to recompute it") from None
-    if len(data) != sidecar.get("npz_bytes") or hashlib.sha256(data).hexdigest() != sidecar.get("npz_sha256"):
-        raise HostError(f"{npz_path}: corrupt or truncated (size/sha256 differ from its sidecar); "
-                        f"delete {npz_path.name} and {json_path.name} to recompute it")
+    check_place(json_path, sidecar, place, index, "dataset")
+    data = read_bound_npz(npz_path, json_path, sidecar)
     arrays = _load_npz(npz_path, data)
     if arrays["s_in"].shape[0] != expected_count:
         raise HostError(f"{npz_path}: {arrays['s_in'].shape[0]} samples, the dataset expects {expected_count}")
@@ -275,7 +259,7 @@ def open_dataset_dir(directory: Path, plan: DatasetPlan) -> None:
     """Create the directory and its manifest, or check that an existing one is the same plan."""
     manifest_path = directory / MANIFEST
     if manifest_path.exists():
-        old = _read_json(manifest_path, "dataset manifest")
+        old = read_json(manifest_path, "dataset manifest")
         if old.get("config_hash") != plan.config_hash():
             raise HostError(f"{directory} holds a dataset of another configuration or OCP formulation "
                             f"(hash {str(old.get('config_hash'))[:12]}…); use another --out")
@@ -296,7 +280,7 @@ def read_manifest(directory: Path) -> dict:
     path = Path(directory) / MANIFEST
     if not path.exists():
         raise HostError(f"{directory}: no {MANIFEST}; not a dataset made by `staregen samples`")
-    manifest = _read_json(path, "dataset manifest")
+    manifest = read_json(path, "dataset manifest")
     if manifest.get("format") != DATASET_FORMAT:
         raise HostError(f"{path}: format {manifest.get('format')!r}, expected {DATASET_FORMAT!r}")
     return manifest
@@ -360,7 +344,7 @@ def timing_summary(directory) -> dict:
     directory = Path(directory)
     solve, solve_cpu, cpu, n = [], [], 0.0, 0
     for path in sorted(directory.glob("shard-*.json")):
-        sidecar = _read_json(path, "shard sidecar")
+        sidecar = read_json(path, "shard sidecar")
         solve.extend(sidecar["timing"]["solve_seconds"])
         solve_cpu.extend(sidecar["timing"]["solve_cpu_seconds"])
         cpu += sidecar["timing"]["cpu_seconds"]

@@ -35,6 +35,7 @@ from codegen.package import config as pc
 from host.control.pid import TABLE1_GAINS
 from host.errors import HostError
 from host.learn.samples import npz_bytes
+from host.learn.shards import check_place, read_bound_npz, read_json
 from host.sim.batched import GainSets, simulate_pid_batch
 from host.sim.metrics import K1, K2
 from host.sim.simulator import SimConfig
@@ -139,24 +140,11 @@ def write_shard(directory: Path, plan: TuningPlan, result: dict) -> None:
 def read_shard(directory: Path, plan: TuningPlan, index: int) -> dict:
     """The arrays of a finished shard, bound to its place in the plan; anything else is a HostError."""
     npz_path, json_path = shard_paths(directory, index)
-    try:
-        sidecar = json.loads(json_path.read_text())
-    except (OSError, ValueError) as exc:
-        raise HostError(f"{json_path}: unreadable shard sidecar ({type(exc).__name__})") from None
+    sidecar = read_json(json_path, "shard sidecar")
     start, stop = plan.shard_range(index)
-    want = {"format": SHARD_FORMAT, "shard": index, "first_triple": start, "count": stop - start,
-            "plan_hash": plan.plan_hash()}
-    for key, value in want.items():
-        if sidecar.get(key) != value:
-            raise HostError(f"{json_path}: {key} is {str(sidecar.get(key))[:40]}, shard {index} of this plan has "
-                            f"{str(value)[:40]}; delete it and its npz to recompute the shard")
-    try:
-        data = npz_path.read_bytes()
-    except OSError:
-        raise HostError(f"{npz_path}: missing although its sidecar exists; delete {json_path.name}") from None
-    if len(data) != sidecar.get("npz_bytes") or hashlib.sha256(data).hexdigest() != sidecar.get("npz_sha256"):
-        raise HostError(f"{npz_path}: corrupt or edited (size/sha256 differ from its sidecar); "
-                        f"delete {npz_path.name} and {json_path.name} to recompute it")
+    check_place(json_path, sidecar, {"format": SHARD_FORMAT, "shard": index, "first_triple": start,
+                                     "count": stop - start, "plan_hash": plan.plan_hash()}, index, "plan")
+    data = read_bound_npz(npz_path, json_path, sidecar)
     try:
         with np.load(io.BytesIO(data), allow_pickle=False) as npz:
             arrays = {k: npz[k] for k in NPZ_ARRAYS}
