@@ -50,7 +50,7 @@ def _run(cmd: list[str], what: str) -> None:
 def build_image(package_dir: str | Path, name: str, target: str, build_dir: str | Path,
                 c_flags: Sequence[str] = ()) -> Path:
     """Configure and build the image of `package_dir` for `target`; returns the ELF (arm) or the
-    executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes -ffast-math to see the guard)."""
+    executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
     if not _NAME.fullmatch(name):

@@ -11,14 +11,12 @@ import argparse
 from pathlib import Path
 
 from codegen import artifact as art
-from codegen import atomic
 from codegen.package import config as pc
 from host.cli.args import parse_int, parse_number
 from host.cli.tune import parse_targets
 from host.control.baselines import load_baselines
 from host.errors import HostError
 from host.learn.training import baselines_path
-from host.sim import impulse
 from host.sim.campaign import check_targets_visible
 from host.sim.simulator import SimConfig
 from host.sim.targets import Target, central_target
@@ -113,15 +111,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise HostError(f"output folder {out} exists and is not a directory")
-    result = evaluate(plan, specs, workers, progress=not args.no_progress)
-    imp = impulse.run("nn", args.network, seed=plan.seed)
-    result["impulse"] = imp.as_dict()
-    out.mkdir(parents=True, exist_ok=True)
-    figures.fig10_scatter(result["staring"], out / "fig10_scatter.png")
-    figures.fig11_12_step(result["step"], out / "fig11_12_step.png")
-    figures.fig13_14_frequency(result["frequency"], out / "fig13_14_frequency.png")
-    impulse.plot(imp, out / "fig15_impulse.png", "NN (float64)")
-    atomic.write_json(out / "evaluate.json", result)
+    result = figures.write_evaluation(evaluate(plan, specs, workers, progress=not args.no_progress),
+                                      args.network, plan.seed, out)
     print(summary(result))
     print(f"wrote {out}/evaluate.json and 4 figures")
     return 0

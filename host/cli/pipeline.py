@@ -195,7 +195,6 @@ def stage_evaluate(ctx: PipelineContext) -> None:
     frequency and impulse responses on a small preset (<out>/evaluate), then the report (<out>/report)."""
     from host.cli.evaluate import summary
     from host.cli.tune import parse_targets
-    from host.sim import impulse
     from host.tune import figures
     from host.tune.evaluate import ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
     from host.tune.report import write_report
@@ -211,16 +210,8 @@ def stage_evaluate(ctx: PipelineContext) -> None:
              ControllerSpec("NN (SIL, x86 C)", "nn-c", (("artifact", net),)),
              ControllerSpec("NN (PIL, ARM, central)", "nn-arm", (("artifact", net),)),
              ControllerSpec("PD+FF", "pdff", (("baselines", laws),))]
-    result = evaluate(plan, specs, progress=False)
-    imp = impulse.run("nn", net, seed=PRESET_SEED)
-    result["impulse"] = imp.as_dict()
     folder = ctx.out / "evaluate"
-    folder.mkdir()
-    figures.fig10_scatter(result["staring"], folder / "fig10_scatter.png")
-    figures.fig11_12_step(result["step"], folder / "fig11_12_step.png")
-    figures.fig13_14_frequency(result["frequency"], folder / "fig13_14_frequency.png")
-    impulse.plot(imp, folder / "fig15_impulse.png", "NN (float64)")
-    atomic.write_json(folder / "evaluate.json", result)
+    result = figures.write_evaluation(evaluate(plan, specs, progress=False), net, PRESET_SEED, folder)
     write_report(ctx.out / "report", folder, ctx.out / "tune", ["staregen pipeline (small presets of tune pid, "
                                                                "evaluate and report)"])
     ctx.results["evaluate"] = {"folder": "evaluate", "report": "report/report.html",

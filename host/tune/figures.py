@@ -1,4 +1,4 @@
-"""Figures of `staregen evaluate` in the paper's numbering: Fig. 10 (J_A vs J_ω per target, every
+"""Figures and files of `staregen evaluate` in the paper's numbering: Fig. 10 (J_A vs J_ω per target, every
 controller), Figs. 11-12 (step responses on the first response target), Figs. 13-14 (magnitude of
 the attitude response to the 0.03 N·m periodic torque). PNG through host.sim.plots (atomic)."""
 from __future__ import annotations
@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from host.sim import plots
+from codegen import atomic
+from host.sim import impulse, plots
 
 AXES = ("x", "y", "z")
 
@@ -60,3 +61,17 @@ def fig13_14_frequency(freq: dict, path: Path) -> Path:
     axes[0].legend(fontsize=8)
     fig.tight_layout()
     return plots._save(fig, path)
+
+
+def write_evaluation(result: dict, network: str, seed: int, out: Path) -> dict:
+    """Add the impulse response of the network (Fig. 15) to `result`, then write evaluate.json and
+    Figs. 10-15 into `out` (created). Returns `result`."""
+    imp = impulse.run("nn", network, seed=seed)
+    result["impulse"] = imp.as_dict()
+    out.mkdir(parents=True, exist_ok=True)
+    fig10_scatter(result["staring"], out / "fig10_scatter.png")
+    fig11_12_step(result["step"], out / "fig11_12_step.png")
+    fig13_14_frequency(result["frequency"], out / "fig13_14_frequency.png")
+    impulse.plot(imp, out / "fig15_impulse.png", "NN (float64)")
+    atomic.write_json(out / "evaluate.json", result)
+    return result
