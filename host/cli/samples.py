@@ -8,6 +8,7 @@ from __future__ import annotations
 
 
 from host.cli.args import parse_int, parse_number
+from host.errors import HostError
 from host.learn.ocp import OBJECTIVES, OcpConfig
 from host.learn.samples import DEFAULT_SHARD_SIZE, DatasetPlan, create_dataset, load_dataset, timing_summary
 
@@ -27,6 +28,11 @@ def register(subparsers) -> None:
     p.add_argument("--torque-bound", default=None,
                    help=f"torque bound per axis in N·m, or 'none' "
                         f"(default {OcpConfig().torque_bound:g}, the wheel limit)")
+    defaults = OcpConfig()
+    p.add_argument("--k1", default=None, help=f"OCP weight of the angle error (default {defaults.k1:g}, eq. 8)")
+    p.add_argument("--k2", default=None, help=f"OCP weight of the rate error (default {defaults.k2:g}, eq. 8)")
+    p.add_argument("--effort-weight", default=None,
+                   help=f"regularised only: weight rho of (M - M_ff)^2 (default 1/289 = {defaults.effort_weight:.6g})")
     p.add_argument("--connect-timeout", default="10", help="seconds to reach --scheduler (default 10)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--out", required=True, help="dataset folder (created; reused when resuming)")
@@ -41,11 +47,23 @@ def _torque_bound(text: str | None) -> float | None:
     return parse_number(text, "--torque-bound", positive=True)
 
 
+def _ocp_config(args) -> OcpConfig:
+    """The OCP settings the flags change; the rest keep docs/ocp.md's defaults."""
+    weights = {}
+    for name, flag in (("k1", "--k1"), ("k2", "--k2"), ("effort_weight", "--effort-weight")):
+        text = getattr(args, name)
+        if text is not None:
+            weights[name] = parse_number(text, flag, non_negative=True)
+    if args.objective == "paper-l1" and "effort_weight" in weights:
+        raise HostError("--effort-weight applies to the regularised objective only (paper-l1 has no effort term)")
+    return OcpConfig(objective=args.objective, torque_bound=_torque_bound(args.torque_bound), **weights)
+
+
 def main(args) -> int:
     n = parse_int(args.n, "--n (the number of samples)", 1)
     plan = DatasetPlan(
         n_samples=n,
-        ocp=OcpConfig(objective=args.objective, torque_bound=_torque_bound(args.torque_bound)),
+        ocp=_ocp_config(args),
         master_seed=parse_int(args.seed, "--seed", 0),
         shard_size=parse_int(args.shard_size, "--shard-size", 1),
     ).validate()

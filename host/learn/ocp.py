@@ -106,6 +106,8 @@ class OcpConfig:
             raise HostError(f"OCP torque_bound must be > 0 or None, got {self.torque_bound}")
         if min(self.k1, self.k2, self.effort_weight) < 0:
             raise HostError("OCP weights k1, k2, effort_weight must be >= 0")
+        if self.k1 == 0 and self.k2 == 0:
+            raise HostError("OCP weights k1 and k2 must not both be 0 (nothing would be tracked)")
         return self
 
     def to_dict(self) -> dict:

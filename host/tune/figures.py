@@ -16,8 +16,9 @@ AXES = ("x", "y", "z")
 def fig10_scatter(staring: dict, path: Path) -> Path:
     plt = plots.plt
     fig, ax = plt.subplots(figsize=(6.5, 4.8))
+    most = max(row["targets"] for row in staring.values())
     for label, row in staring.items():
-        if row["targets"] > 1:
+        if row["targets"] == most:      # rows over every target (the PIL row flies the central one only)
             ax.scatter(row["per_target"]["J_A"], row["per_target"]["J_w"], s=10, label=label)
     ax.set_xlabel("J_A [°]")
     ax.set_ylabel("J_ω [°/s]")

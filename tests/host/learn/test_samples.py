@@ -209,6 +209,18 @@ def test_cli_creates_a_dataset_and_a_rerun_keeps_it(tmp_path, capsys):
     assert "(2 finished shards kept, 0 computed)" in capsys.readouterr().out
 
 
+def test_cli_weights_reach_the_ocp_and_move_the_optimum(tmp_path, capsys):
+    """--k1/--k2/--effort-weight are recorded in dataset.json and change the solved commands."""
+    base = ["samples", "--n", "2", "--shard-size", "2", "--workers", "1", "--no-progress", "--out"]
+    assert cli_main(base + [str(tmp_path / "d")]) == 0
+    assert cli_main(base + [str(tmp_path / "w"), "--k1", "0.5", "--k2", "30", "--effort-weight", "0.01"]) == 0
+    capsys.readouterr()
+    ocp = json.loads((tmp_path / "w" / "dataset.json").read_text())["ocp"]
+    assert (ocp["k1"], ocp["k2"], ocp["effort_weight"]) == (0.5, 30.0, 0.01)
+    (Xd, Yd, _, _), (Xw, Yw, _, _) = load_dataset(tmp_path / "d"), load_dataset(tmp_path / "w")
+    assert np.array_equal(Xd, Xw) and not np.allclose(Yd, Yw, rtol=1e-3, atol=0)
+
+
 # ----------------------------------------------------------------------------- determinism and resume (real solves)
 
 

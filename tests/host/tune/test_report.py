@@ -9,7 +9,7 @@ import numpy as np
 
 from host.cli import main
 from host.tune import figures
-from host.tune.report import PAPER_TABLE9
+from host.tune.report import PAPER_TABLE9, _g
 
 
 class Collect(HTMLParser):
@@ -89,3 +89,25 @@ def test_bad_inputs(tmp_path, capsys):
     (tmp_path / "ev" / "evaluate.json").write_text("{}")
     assert main(["report", "--evaluate", str(tmp_path / "ev"), "--out", str(tmp_path / "r")]) == 2
     assert "not written by" in capsys.readouterr().err
+
+
+def test_report_of_a_real_evaluation_holds_every_table_and_figure(tmp_path, artifact_file):
+    """The path a user runs: `staregen evaluate` (small) then `staregen report`; the HTML parsed."""
+    ev, out = tmp_path / "ev", tmp_path / "r"
+    assert main(["evaluate", "--network", artifact_file, "--controllers", "pid,nn", "--targets", "central",
+                 "--duration", "12", "--response-targets", "1", "--freqs", "1", "--workers", "1",
+                 "--no-progress", "--out", str(ev)]) == 0
+    assert main(["report", "--evaluate", str(ev), "--out", str(out)]) == 0
+    text = (out / "report.html").read_text()
+    p = Collect()
+    p.feed(text)
+    # Table 8 (central), Table 9 (targets), step, frequency; no tuning table without --tune
+    assert p.tables == 4
+    figs = ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png")
+    assert len(p.imgs) == len(figs) and all(i["src"].startswith("data:image/png;base64,") for i in p.imgs)
+    assert all((out / n).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for n in figs)
+    evaluation = json.loads((ev / "evaluate.json").read_text())
+    for label, row in evaluation["staring"].items():
+        assert label in p.cells and _g(row["J"]) in p.cells
+    md = (out / "report.md").read_text()
+    assert md.count("\n|---|") == 4 and md.count("![") == len(figs)
