@@ -39,6 +39,7 @@ COMMANDS = [
     "host.cli.evaluate",
     "host.cli.report",
     "host.cli.tanh",
+    "host.cli.dp",
 ]
 
 

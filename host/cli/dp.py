@@ -1,0 +1,70 @@
+"""`staregen dp`: the discrete-point controller of seed paper 003 (docs/discrete-point.md).
+
+accuracy: the host law (float64) on the network's 75/25 split of a `staregen samples` dataset over a
+grid of r × S_limit, beside the 12-40-3 network and the fitted baselines; a markdown table on
+stdout and, with --out, in a file.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+from tqdm import tqdm
+
+from codegen import atomic
+from host.cli.args import parse_int, parse_number
+from host.control.discrete_point import DpConfig
+from host.control.nn_controller import load_artifact
+from host.errors import HostError
+from host.learn import training
+from host.learn.discrete_point_sweep import markdown, sweep
+
+
+def register(subparsers) -> None:
+    p = subparsers.add_parser("dp", help="the discrete-point controller (paper 003): host accuracy",
+                              description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="dp_command", required=True, metavar="ACTION")
+    a = sub.add_parser("accuracy", help="r x S_limit accuracy table on the network's test split")
+    a.add_argument("--data", required=True, help="dataset folder written by `staregen samples`")
+    a.add_argument("--network", default=None, help="artifact trained on --data (its row joins the table)")
+    a.add_argument("--r", default="0.03,0.05,0.07,0.1", help="box sides, fractions of each range, in (0, 1)")
+    a.add_argument("--s-limit", default="64,128,256,512", help="point caps, integers >= 13")
+    d = DpConfig()
+    a.add_argument("--n-min", default=str(d.n_min), help=f"points needed before widening (default {d.n_min})")
+    a.add_argument("--widen", default=str(d.widen), help=f"box growth per level (default {d.widen:g})")
+    a.add_argument("--seed", default="0", help="split seed, as `staregen train --seed` (default 0)")
+    a.add_argument("--out", default=None, help="markdown file to write (atomically)")
+    a.add_argument("--no-progress", action="store_true", help="no progress bar")
+    a.set_defaults(func=accuracy_main)
+
+
+def _list(text: str, what: str, parse) -> tuple:
+    parts = [p for p in text.split(",") if p.strip()]
+    if not parts:
+        raise HostError(f"{what} needs at least one value")
+    return tuple(parse(p.strip()) for p in parts)
+
+
+def accuracy_main(args) -> int:
+    rs = _list(args.r, "--r", lambda p: parse_number(p, "--r", positive=True))
+    s_limits = _list(args.s_limit, "--s-limit", lambda p: parse_int(p, "--s-limit", 1))
+    base = DpConfig(n_min=parse_int(args.n_min, "--n-min", 1), widen=parse_number(args.widen, "--widen"),
+                    s_limit=max(s_limits))
+    for r in rs:
+        DpConfig(r=r).validate()
+    for s in s_limits:
+        DpConfig(s_limit=s, n_min=min(base.n_min, s)).validate()
+    base.validate()
+    X, Y, report = training.load_training_data(args.data)
+    network = None if args.network is None else load_artifact(args.network)
+    seed = parse_int(args.seed, "--seed", 0)
+    with tqdm(total=len(rs) * len(s_limits), desc="discrete point", disable=args.no_progress, delay=0.5) as bar:
+        rows = sweep(X, Y, rs, s_limits, base, network, seed, bound=training.torque_bound_of(report),
+                     progress=bar.update)
+    text = f"{len(X)} samples from {args.data}, split seed {seed} (75 / 25)\n\n" + markdown(rows) + "\n"
+    print(text, end="")
+    if args.out is not None:
+        out = Path(args.out)
+        if not out.parent.is_dir():
+            raise HostError(f"--out: folder {out.parent} does not exist")
+        atomic.write_text(out, text)
+    return 0
