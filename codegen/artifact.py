@@ -773,8 +773,8 @@ def _check_seal(r: _Reader, doc: dict) -> None:
                          "(payload modified after it was sealed)")
 
 
-def load(path: str | os.PathLike) -> Artifact:
-    """Read and validate an artifact file; any problem raises ArtifactError naming the field."""
+def read_document(path: str | os.PathLike):
+    """A sealed JSON file's document (any artifact format): size-capped, UTF-8, strict JSON."""
     path = Path(path)
     try:
         if path.stat().st_size > MAX_FILE_BYTES:
@@ -784,7 +784,12 @@ def load(path: str | os.PathLike) -> Artifact:
         raise ArtifactError("file", "no such file", str(path)) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise ArtifactError("file", f"cannot read: {exc}", str(path)) from None
-    return from_document(parse_json(text, str(path)), str(path))
+    return parse_json(text, str(path))
+
+
+def load(path: str | os.PathLike) -> Artifact:
+    """Read and validate an artifact file; any problem raises ArtifactError naming the field."""
+    return from_document(read_document(path), str(path))
 
 
 MAX_FILE_BYTES = 64 << 20

@@ -109,6 +109,9 @@ class Unit(ABC):
     """One generated unit bound to its inputs (artifact, parameters, configuration)."""
 
     kind: str = ""                 # registry name, e.g. "network"
+    # Emulator cap per step (a runaway loop ends in an error, not a hang); the network needs a few
+    # thousand instructions, a unit that scans tables (dp) sets its own.
+    max_instructions: int = 1_000_000
 
     def __init__(self, entry: str, input_dtype: np.dtype, output_dtype: np.dtype,
                  state_dtype: np.dtype | None, budgets: Budgets):

@@ -15,7 +15,7 @@ import numpy as np
 
 from tools.errors import ToolError
 from tools.m4.elf import Image
-from tools.m4.harness import Harness
+from tools.m4.harness import MAX_INSNS_PER_RECORD, Harness
 from tools.m4.profile import MODES, Profiler
 
 CLOCK_HZ = 168_000_000
@@ -41,13 +41,13 @@ class EntryProfile:
 
 
 def profile_entry(elf: str | Path | Image, entry: str, classes: dict[str, np.ndarray],
-                  modes=MODES) -> EntryProfile:
+                  modes=MODES, max_insns_per_record: int = MAX_INSNS_PER_RECORD) -> EntryProfile:
     """classes: {name: (N, in_bytes) uint8 records}. The entry function must be called once per
     record by the harness adapter (directly or through a tail call)."""
     image = elf if isinstance(elf, Image) else Image(elf)
     modes = tuple(m for m in MODES if m in modes)
     prof = Profiler(image, entry, memory_modes=modes != ("ideal",))
-    harness = Harness(image, machine=prof.machine)
+    harness = Harness(image, machine=prof.machine, max_insns_per_record=max_insns_per_record)
     per_class, start = {}, 0
     prof.machine.paint_stack()
     for name, records in classes.items():

@@ -24,7 +24,7 @@ def cycle_report(unit: Unit, modes, per_class: int, seed: int, extra: dict[str, 
     image = Image(build.elf)
     classes = {**unit.cycle_classes(per_class, seed), **(extra or {})}
     records = {c: pack(unit, b).view(np.uint8).reshape(b.input.shape[0], -1) for c, b in classes.items()}
-    prof = profile_entry(image, unit.step_symbol, records, modes)
+    prof = profile_entry(image, unit.step_symbol, records, modes, unit.max_instructions)
     sz = size.sizes(build.elf, build.map)
     objs = sz.of_objects(unit.objects)
     bound = stack.worst_case(image, build.su_files, unit.step_symbol)

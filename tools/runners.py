@@ -229,7 +229,8 @@ class ArmRunner:
         image = Image(arm_build(unit, "sequence").elf)
         if cycles:
             self.profiler = Profiler(image, unit.step_symbol, memory_modes=False)
-        self._sequence = Harness(image, machine=self.profiler.machine if cycles else None)
+        self._sequence = Harness(image, machine=self.profiler.machine if cycles else None,
+                                 max_insns_per_record=unit.max_instructions)
         self.cycles: list[int] = []
         self.reset()
 
@@ -239,7 +240,8 @@ class ArmRunner:
 
     def records(self, batch: Batch):
         if self._records is None:
-            self._records = Harness(arm_build(self.unit, "records").elf)
+            self._records = Harness(arm_build(self.unit, "records").elf,
+                                    max_insns_per_record=self.unit.max_instructions)
         rec = pack(self.unit, batch)
         return unpack(self.unit, self._records.run(rec.view(np.uint8).reshape(rec.shape[0], -1)))
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from codegen import artifact as art
 from codegen import units
 from codegen.unit import Unit
+from codegen.units.dp import tables as dp_tables
 from codegen.units.tanh.params import load_params
 from host.cli.args import parse_number
 from host.errors import HostError
@@ -28,6 +29,7 @@ def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network"
                         + f" (default {default})")
     parser.add_argument("--artifact", metavar="FILE", help="model artifact (units network, controller)")
     parser.add_argument("--params", metavar="FILE", help="parameter file, .toml/.json (unit tanh)")
+    parser.add_argument("--tables", metavar="FILE", help="discrete-point tables (unit dp; `staregen dp build`)")
     parser.add_argument("--period", default=None, metavar="S", help="control period baked into the unit, s "
                         "(unit tanh; default 0.1)")
     parser.add_argument("--name", default=None, help="entry name: files <name>.h/.c, functions <name>_* "
@@ -42,7 +44,8 @@ def deprecated(old: str, new: str) -> None:
 def unit_from_args(args: argparse.Namespace) -> Unit:
     """The unit of --unit bound to --artifact / --params / --period / --name; user errors are one line."""
     kind = units.get(args.unit)
-    given = {"artifact": args.artifact, "params": args.params}
+    tables = getattr(args, "tables", None)      # `staregen tanh` (deprecated) has no --tables
+    given = {"artifact": args.artifact, "params": args.params, "tables": tables}
     for flag, value in given.items():
         if value is not None and flag not in kind.needs:
             raise HostError(f"--{flag} does not apply to unit {args.unit}")
@@ -53,6 +56,8 @@ def unit_from_args(args: argparse.Namespace) -> Unit:
         inputs["period"] = parse_number(args.period, "--period", positive=True)
     if args.params is not None:
         inputs["params"] = load_params(args.params)
+    if tables is not None:
+        inputs["tables"] = dp_tables.load(tables)
     if args.artifact is not None:
         inputs["artifact"] = art.load(args.artifact)
     elif args.unit == "controller":

@@ -25,50 +25,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from codegen.units.dp.params import N_IN, N_OUT, N_PARAM, DpParams
 from host.errors import HostError
 
-N_IN, N_OUT = 12, 3
-N_PARAM = N_IN + 1                  # affine: intercept + 12 slopes
 XORSHIFT_SEED = 0x9E3779B9          # any non-zero 32-bit state; fixed so a query is a pure function
 MEAN_ABS_TO_SIGMA = 1.2533141373155  # sqrt(pi/2): E|e| = sigma·sqrt(2/pi) for Gaussian residuals
-
-
-@dataclass(frozen=True)
-class DpConfig:
-    """Every number that shapes the controller's output besides the samples."""
-    r: float = 0.05              # box side as a fraction of each dimension's sample range, level 0
-    s_limit: int = 64            # at most this many points enter the fit (paper 003: 256 / 512)
-    n_min: int = 26              # fewer points in a level's box: widen (2 x 13 parameters)
-    iterations: int = 3          # IRLS reweightings after the unweighted fit
-    tukey_c: float = 4.685       # bisquare tuning constant (95 % Gaussian efficiency)
-    ridge: float = 1e-6          # added to the slope diagonal, relative to the weight sum
-    widen: float = 1.25          # box side factor from one level to the next (2: 0.85 % -> 1.59 % error)
-
-    def validate(self) -> "DpConfig":
-        if not (isinstance(self.r, float | int) and 0.0 < float(self.r) < 1.0):
-            raise HostError(f"discrete-point r must lie in (0, 1) (a fraction of each range), got {self.r}")
-        if not isinstance(self.s_limit, int) or self.s_limit < N_PARAM:
-            raise HostError(f"discrete-point S_limit must be an integer >= {N_PARAM} (the affine fit's "
-                            f"parameters), got {self.s_limit}")
-        if not isinstance(self.n_min, int) or not N_PARAM <= self.n_min <= self.s_limit:
-            raise HostError(f"discrete-point n_min must be an integer in [{N_PARAM}, S_limit = {self.s_limit}], "
-                            f"got {self.n_min}")
-        if not isinstance(self.iterations, int) or not 0 <= self.iterations <= 20:
-            raise HostError(f"discrete-point IRLS iterations must be an integer in [0, 20], got {self.iterations}")
-        if not (isinstance(self.widen, float | int) and 1.0 < float(self.widen) <= 4.0):
-            raise HostError(f"discrete-point widening factor must lie in (1, 4], got {self.widen}")
-        if not (self.tukey_c > 0 and self.ridge >= 0 and np.isfinite(self.tukey_c) and np.isfinite(self.ridge)):
-            raise HostError("discrete-point tukey_c must be > 0 and ridge >= 0 (finite)")
-        return self
-
-    def sides(self) -> tuple[float, ...]:
-        """Box sides (fractions of the range) of the boxed levels: r·widen^l until a side reaches 2, where
-        a box centred inside the sample range holds every sample; the last level takes every sample."""
-        out, side = [], float(self.r)
-        while side < 2.0:
-            out.append(side)
-            side *= float(self.widen)
-        return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -133,7 +94,7 @@ class Neighbourhood:
     level: int           # index into sides(); len(sides()) = every sample
 
 
-def select(t: DpTables, c: DpConfig, q: np.ndarray) -> Neighbourhood:
+def select(t: DpTables, c: DpParams, q: np.ndarray) -> Neighbourhood:
     """Steps 1-3: the first level whose box holds at least n_min points, capped at s_limit."""
     sides = c.sides()
     for level, side in enumerate(sides):
@@ -153,7 +114,7 @@ def select(t: DpTables, c: DpConfig, q: np.ndarray) -> Neighbourhood:
     return Neighbourhood(reservoir(every, c.s_limit), t.n, len(sides))
 
 
-def irls_intercept(Z: np.ndarray, y: np.ndarray, c: DpConfig) -> float:
+def irls_intercept(Z: np.ndarray, y: np.ndarray, c: DpParams) -> float:
     """Step 4 for one output: the affine IRLS fit's value at the query (Z: (m, 12) scaled offsets)."""
     Phi = np.hstack([np.ones((len(Z), 1)), Z])
     w = np.ones(len(Z))
@@ -183,14 +144,14 @@ class DpResult:
 class DpModel:
     """Tables + configuration: the float64 discrete-point law."""
 
-    def __init__(self, tables: DpTables, config: DpConfig = DpConfig()):
+    def __init__(self, tables: DpTables, config: DpParams = DpParams()):
         self.tables, self.config = tables, config.validate()
         if tables.n < self.config.n_min:
             raise HostError(f"discrete-point controller needs at least n_min = {self.config.n_min} samples, "
                             f"got {tables.n}")
 
     @classmethod
-    def fit(cls, X: np.ndarray, Y: np.ndarray, config: DpConfig = DpConfig()) -> "DpModel":
+    def fit(cls, X: np.ndarray, Y: np.ndarray, config: DpParams = DpParams()) -> "DpModel":
         config = config.validate()
         return cls(DpTables.build(X, Y, config.n_min), config)
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from codegen import artifact as art
 from host.control.baselines import LinearLS, SaturatedLinear
-from host.control.discrete_point import DpConfig, DpModel
+from host.control.discrete_point import DpParams, DpModel
 from host.control.nn_controller import network64
 from host.errors import HostError
 from host.learn import training as tr
@@ -34,7 +34,7 @@ def measure(label: str, Y_true: np.ndarray, Y_pred: np.ndarray, **extra) -> Accu
                     float(np.max(np.abs(err))), **extra)
 
 
-def dp_accuracy(split: tr.Split, config: DpConfig) -> Accuracy:
+def dp_accuracy(split: tr.Split, config: DpParams) -> Accuracy:
     t0 = time.perf_counter()
     model = DpModel.fit(split.X_train, split.Y_train, config)
     results = [model.query(q) for q in split.X_test]
@@ -57,7 +57,7 @@ def network_accuracy(a: art.Artifact, split: tr.Split, X: np.ndarray, Y: np.ndar
     return measure(f"network {a.n_in}-{a.n_hidden}-{a.n_out} tansig", split.Y_test, pred)
 
 
-def sweep(X: np.ndarray, Y: np.ndarray, rs: tuple[float, ...], s_limits: tuple[int, ...], base: DpConfig,
+def sweep(X: np.ndarray, Y: np.ndarray, rs: tuple[float, ...], s_limits: tuple[int, ...], base: DpParams,
           network: art.Artifact | None = None, seed: int = 0, bound: float | None = None,
           progress=None) -> list[Accuracy]:
     """Rows: the network (if given), PD + feed-forward (saturated at the dataset's torque `bound`, as

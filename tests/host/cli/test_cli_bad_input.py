@@ -53,7 +53,7 @@ CASES = [
     (["samples", "--n", "10", "--k2", "-5", "--out", "{tmp}/s"], "--k2 must not be negative"),
     (["dp", "accuracy", "--data", "{tmp}/none", "--r", "1.5"], "r must lie in (0, 1)"),
     (["dp", "accuracy", "--data", "{tmp}/none", "--r", "0"], "--r must be positive"),
-    (["dp", "accuracy", "--data", "{tmp}/none", "--s-limit", "12"], "S_limit must be an integer >= 13"),
+    (["dp", "accuracy", "--data", "{tmp}/none", "--s-limit", "12"], "S_limit must be an integer in [13, 4096]"),
     (["dp", "accuracy", "--data", "{tmp}/none", "--s-limit", ","], "--s-limit needs at least one value"),
     (["dp", "accuracy", "--data", "{tmp}/none"], "none"),
     (["samples", "--n", "10", "--k1", "nan", "--out", "{tmp}/s"], "--k1 must be finite"),

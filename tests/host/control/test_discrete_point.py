@@ -6,8 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from host.control.discrete_point import (DpConfig, DpModel, DpTables, irls_intercept, reservoir, select,
+from host.control.discrete_point import (DpParams, DpModel, DpTables, irls_intercept, reservoir, select,
                                          xorshift32)
+from codegen.units.dp.params import DpParamsError
 from host.errors import HostError
 
 
@@ -29,8 +30,8 @@ def test_tables_hold_the_papers_invariant():
 
 def test_affine_data_is_reproduced_exactly_at_any_query():
     X, Y, A, b = _samples()
-    exact = DpModel.fit(X, Y, DpConfig(r=0.05, s_limit=64, ridge=0.0))
-    ridged = DpModel.fit(X, Y, DpConfig(r=0.05, s_limit=64))
+    exact = DpModel.fit(X, Y, DpParams(r=0.05, s_limit=64, ridge=0.0))
+    ridged = DpModel.fit(X, Y, DpParams(r=0.05, s_limit=64))
     rng = np.random.default_rng(1)
     for q in rng.uniform(-0.4, 0.4, (20, 12)):
         assert np.allclose(exact.query(q).torque, q @ A + b, rtol=0, atol=1e-9)
@@ -43,14 +44,14 @@ def test_irls_rejects_outliers_that_move_least_squares():
     Z = rng.uniform(-0.5, 0.5, (200, 12))
     y = 0.3 + Z @ rng.normal(size=12) + rng.normal(0, 1e-3, 200)
     y[:20] += 5.0                                   # 10 % gross errors
-    ols = irls_intercept(Z, y, DpConfig(iterations=0))
-    robust = irls_intercept(Z, y, DpConfig(iterations=5))
+    ols = irls_intercept(Z, y, DpParams(iterations=0))
+    robust = irls_intercept(Z, y, DpParams(iterations=5))
     assert abs(ols - 0.3) > 0.3 and abs(robust - 0.3) < 2e-3
 
 
 def test_selection_equals_a_brute_force_box_scan():
     X, Y, _, _ = _samples(400)
-    c = DpConfig(r=0.1, s_limit=32, n_min=20)
+    c = DpParams(r=0.1, s_limit=32, n_min=20)
     t = DpTables.build(X, Y)
     rng = np.random.default_rng(3)
     for q in rng.uniform(-1, 1, (30, 12)):
@@ -77,14 +78,14 @@ def test_reservoir_is_deterministic_and_draws_from_the_hits():
 @pytest.mark.parametrize("kwargs, message", [
     ({"r": 0.0}, "r must lie in (0, 1)"),
     ({"r": 1.0}, "r must lie in (0, 1)"),
-    ({"s_limit": 12, "n_min": 12}, "S_limit must be an integer >= 13"),
+    ({"s_limit": 12, "n_min": 12}, "S_limit must be an integer in [13, 4096]"),
     ({"n_min": 100, "s_limit": 64}, "n_min must be an integer in [13, S_limit = 64]"),
     ({"iterations": -1}, "iterations"),
     ({"widen": 1.0}, "widening factor"),
 ])
 def test_bad_settings_are_refused_in_one_line(kwargs, message):
-    with pytest.raises(HostError) as e:
-        DpConfig(**kwargs).validate()
+    with pytest.raises(DpParamsError) as e:
+        DpParams(**kwargs).validate()
     assert message in str(e.value) and "\n" not in str(e.value)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from host.control.discrete_point import DpConfig
+from codegen.units.dp.params import DpParams
 from host.control.nn_controller import load_artifact
 from host.errors import HostError
 from host.learn.discrete_point_sweep import markdown, measure, sweep
@@ -23,7 +23,7 @@ def test_sweep_on_affine_samples_has_every_row_and_tiny_errors():
     rng = np.random.default_rng(0)
     X = rng.uniform(-1, 1, (400, 12))
     Y = X @ rng.normal(size=(12, 3)) + 0.5
-    rows = sweep(X, Y, (0.05, 0.2), (32, 64), DpConfig(n_min=26))
+    rows = sweep(X, Y, (0.05, 0.2), (32, 64), DpParams(n_min=26))
     assert [r.label for r in rows][:2] == ["PD + feed-forward (saturated linear)", "linear least squares"]
     dp = rows[2:]
     assert len(dp) == 4 and all(r.relative_torque_error < 1e-4 for r in dp)
@@ -36,4 +36,4 @@ def test_network_trained_elsewhere_is_refused():
     rng = np.random.default_rng(1)
     X = rng.uniform(-1, 1, (100, 12))
     with pytest.raises(HostError, match="not trained on this dataset"):
-        sweep(X, X[:, :3], (0.1,), (32,), DpConfig(), network=load_artifact(None))
+        sweep(X, X[:, :3], (0.1,), (32,), DpParams(), network=load_artifact(None))
