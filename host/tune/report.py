@@ -138,6 +138,16 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
     blocks = [Block("h1", "staregen: tuning and evaluation against paper 001 §7")]
     facts = ", ".join(f"{k} {v}" for k, v in run_facts.items())
     blocks.append(Block("p", f"Run: {facts}."))
+    plan = evaluation.get("plan")
+    if plan:
+        blocks.append(Block("p", f"Evaluation plan: {plan['targets']} staring targets × {plan['duration']:g} s, step "
+                                 f"response over {plan['response_targets']} target(s), frequencies "
+                                 f"{', '.join(_g(f) for f in plan['freqs_hz'])} Hz, noise seed {plan['seed']}."))
+        if plan["targets"] < 100 or plan["duration"] < 100:
+            blocks.append(Block("p", "A reduced run: the paper's Tables 8-9 come from 100 targets × 100 s, and a "
+                                     "short run weighs the first seconds of imaging (transients, the integral "
+                                     "term) more; `staregen evaluate --targets all` is the comparable run "
+                                     "(BENCHMARKS.md)."))
     if tuning:
         rows = tuple((axis, _g(b["kp"]), _g(b["ki"]), _g(b["kd"]), _g(b["objective"]),
                       _g(b["table1_objective"]) if b["table1_on_grid"] else "not on grid")

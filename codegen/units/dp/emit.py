@@ -16,6 +16,8 @@ from codegen.units.dp.tables import DpTables, stack_estimate
 
 TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_NAME = "dp"
+# Points per block of the normal equations: 8 t's and one sum in registers (docs/discrete-point.md).
+BLOCK = 8
 
 
 def tables_crc32(t: DpTables) -> int:
@@ -37,7 +39,7 @@ def template_context(t: DpTables, name: str) -> dict:
         "name": name, "P": name.upper(), "generator_version": GENERATOR_VERSION, "sha256": t.sha256,
         "creator": comment(t.metadata.get("creator", "")),
         "n": t.n, "s_limit": p.s_limit, "n_min": p.n_min, "iterations": p.iterations, "n_levels": t.n_levels,
-        "bisect_steps": math.ceil(math.log2(t.n + 1)),
+        "bisect_steps": math.ceil(math.log2(t.n + 1)), "block": BLOCK,
         "r_text": f"{p.r:g}", "widen_text": f"{p.widen:g}", "ridge_text": f"{p.ridge:g}", "tukey_text": f"{p.tukey_c:g}",
         "c_scale": c_float(c.c_scale), "ridge": c_float(c.ridge),
         "stack_estimate": stack_estimate(p.s_limit), "flash_bytes": t.flash_bytes,

@@ -111,3 +111,4 @@ def test_report_of_a_real_evaluation_holds_every_table_and_figure(tmp_path, arti
         assert label in p.cells and _g(row["J"]) in p.cells
     md = (out / "report.md").read_text()
     assert md.count("\n|---|") == 4 and md.count("![") == len(figs)
+    assert "Evaluation plan: 1 staring targets × 12 s" in md and "A reduced run" in md
