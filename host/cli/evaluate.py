@@ -17,6 +17,7 @@ from host.cli.tune import parse_targets
 from host.control.baselines import load_baselines
 from host.errors import HostError
 from host.learn.training import baselines_path
+from host.control.dp_controller import load_tables
 from host.sim.campaign import check_targets_visible
 from host.sim.simulator import SimConfig
 from host.sim.targets import Target, central_target
@@ -31,6 +32,8 @@ def register(subparsers) -> None:
     p.add_argument("--baselines", default=None, metavar="FILE",
                    help="fitted baselines (default: <network>.baselines.json when it exists)")
     p.add_argument("--tuned", default=None, metavar="FILE", help="controller.toml with tuned PID gains")
+    p.add_argument("--dp-tables", default=None, metavar="FILE",
+                   help="discrete-point tables (`staregen dp build`): adds the paper-003 law (and its C with --sil)")
     p.add_argument("--targets", default="all",
                    help="staring targets: all, central, N (the first N of the 100) or a target list file")
     p.add_argument("--response-targets", default="10", help="targets averaged in the step response (default 10)")
@@ -49,7 +52,7 @@ def register(subparsers) -> None:
 
 # --controllers names -> labels of the specs below
 KEYS = {"pid": "PID (Table 1)", "pid-tuned": "PID (tuned)", "nn": "NN (float64)", "nn-c": "NN (SIL, x86 C)",
-        "nn-arm": "NN (PIL, ARM, central)", "pdff": "PD+FF"}
+        "nn-arm": "NN (PIL, ARM, central)", "pdff": "PD+FF", "dp": "DP (float64)", "dp-c": "DP (SIL, x86 C)"}
 
 
 def select(specs: list[ControllerSpec], text: str | None) -> list[ControllerSpec]:
@@ -66,7 +69,8 @@ def select(specs: list[ControllerSpec], text: str | None) -> list[ControllerSpec
     missing = [n for n in names if KEYS[n] not in available]
     if missing:
         raise HostError(f"--controllers {', '.join(missing)}: not available with these inputs "
-                        "(pid-tuned needs --tuned, nn-c --sil, nn-arm --pil, pdff a baselines file)")
+                        "(pid-tuned needs --tuned, nn-c --sil, nn-arm --pil, pdff a baselines file, dp --dp-tables, "
+                        "dp-c --dp-tables and --sil)")
     wanted = {KEYS[n] for n in names}
     return [s for s in specs if s.label in wanted]
 
@@ -88,6 +92,11 @@ def controller_specs(args) -> list[ControllerSpec]:
     if laws:
         load_baselines(laws)
         specs.append(ControllerSpec("PD+FF", "pdff", (("baselines", laws),)))
+    if args.dp_tables:
+        load_tables(args.dp_tables)   # a missing or invalid file is reported before anything runs
+        specs.append(ControllerSpec("DP (float64)", "dp", (("tables", args.dp_tables),)))
+        if args.sil:
+            specs.append(ControllerSpec("DP (SIL, x86 C)", "dp-c", (("tables", args.dp_tables),)))
     return select(specs, args.controllers)
 
 

@@ -14,7 +14,8 @@ from host.sim import tanh_example, tanh_in_loop
 from host.cli.args import parse_int, parse_number
 from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
 from host.control.baselines import load_baselines
-from host.control.controllers import ARTIFACT_CONTROLLERS, BASELINE_CONTROLLERS, CONTROLLERS
+from host.control.controllers import ARTIFACT_CONTROLLERS, BASELINE_CONTROLLERS, CONTROLLERS, DP_CONTROLLERS
+from host.control.dp_controller import load_tables
 from host.errors import HostError
 from host.sim.metrics import ImagingPlan
 from host.sim.simulator import SimConfig
@@ -42,6 +43,8 @@ def register(subparsers) -> None:
                         "default: a stand-in network fitted to the PID law")
     p.add_argument("--baselines", default=None, metavar="FILE",
                    help="fitted baselines for pdff / linear (network.baselines.json from train or the pipeline)")
+    p.add_argument("--tables", default=None, metavar="FILE",
+                   help="discrete-point tables for dp / dp-c (`staregen dp build`)")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
     p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
@@ -121,6 +124,16 @@ def controller_options(args) -> dict:
     """Factory options: the artifact of a network controller, the baselines file of a fitted
     baseline (each checked here: a clear user error)."""
     baselines = getattr(args, "baselines", None)   # commands without --baselines (impulse) fly no baseline
+    tables = getattr(args, "tables", None)
+    if tables is not None and args.controller not in DP_CONTROLLERS:
+        raise HostError(f"--tables applies to {', '.join(DP_CONTROLLERS)} only")
+    if args.controller in DP_CONTROLLERS:
+        if args.artifact is not None or baselines is not None:
+            raise HostError(f"--artifact and --baselines do not apply to {args.controller}")
+        if tables is None:
+            raise HostError(f"controller {args.controller} needs --tables FILE (written by `staregen dp build`)")
+        load_tables(tables)   # a missing or invalid file is reported before anything runs
+        return {"tables": tables}
     if baselines is not None and args.controller not in BASELINE_CONTROLLERS:
         raise HostError(f"--baselines applies to {', '.join(BASELINE_CONTROLLERS)} only")
     if args.controller in BASELINE_CONTROLLERS:

@@ -55,11 +55,15 @@ CONTROLLERS = {
     "nn-arm": "host.control.generated_controller:make_pil_controller",
     "pdff": "host.control.baseline_controllers:make_pdff_controller",
     "linear": "host.control.baseline_controllers:make_linear_controller",
+    "dp": "host.control.dp_controller:make_dp_controller",
+    "dp-c": "host.control.dp_controller:make_dp_sil_controller",
 }
 # Controllers built from a model artifact accept `artifact=` (a file path, None = the stand-in).
 ARTIFACT_CONTROLLERS = ("nn", "nn-c", "pid-c", "nn-arm")
 # The fitted baselines accept `baselines=` (a baselines file written by `staregen train`).
 BASELINE_CONTROLLERS = ("pdff", "linear")
+# The discrete-point controllers accept `tables=` (a tables file written by `staregen dp build`).
+DP_CONTROLLERS = ("dp", "dp-c")
 
 
 def build_controller(name: str, *, torque_limit: float, control_period: float, **options) -> Controller:

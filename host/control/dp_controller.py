@@ -1,0 +1,107 @@
+"""The discrete-point law (seed paper 003) flown in the staring simulator as the network is: the
+controller of Fig. 2 with the law in the network's place. Inside the Table 2 envelope (and with a
+finite measurement) the law flies after `dwell_steps` clean steps; otherwise, or when the law
+reports its input invalid, the Table 1 PID flies (the same mode logic, integrator and saturation
+as host.control.nn_controller).
+
+  dp     the float64 law (host.control.discrete_point) on the tables' float32 samples;
+  dp-c   the generated C of the `dp` unit on x86 (SIL, through tools.inloop).
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from codegen.artifact import table2_envelope
+from codegen.units.controller import spec as cs
+from codegen.units.dp import golden as dp_golden
+from codegen.units.dp import tables as dp_tables
+from codegen.units.dp.unit import DpUnit
+from host.control.controllers import ControlOutput, Measurement
+from host.control.discrete_point import DpModel, DpTables as DpTables64
+from host.control.nn_controller import (ModeLogic, TrackingPid, bound_flags, clip_torque, flight_config,
+                                        measurement_finite)
+from host.core.constants import DEG
+from host.errors import HostError
+from host.gnc.preprocess import preprocess
+from tools.inloop import InTheLoop
+
+
+@functools.lru_cache(maxsize=4)
+def load_tables(path: str) -> dp_tables.DpTables:
+    return dp_tables.load(path)
+
+
+class Float64Law:
+    """The float64 law on the tables' samples; returns (torque, invalid)."""
+
+    def __init__(self, t: dp_tables.DpTables):
+        X, Y = t.X.astype(np.float64), t.Y.astype(np.float64)
+        self.model = DpModel(DpTables64.build(X, Y, t.params.n_min), t.params)
+
+    def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
+        if not np.all(np.isfinite(x_deg)):
+            return np.zeros(3), True
+        return self.model.query(x_deg).torque, False
+
+
+class GeneratedLaw:
+    """The generated step on x86 (cffi) through the one in-the-loop runner."""
+
+    def __init__(self, t: dp_tables.DpTables, golden_twin: bool = False):
+        self.loop = InTheLoop(DpUnit(t), "x86", golden_twin=golden_twin)
+
+    def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
+        rec = np.zeros(1, dtype=dp_golden.INPUT_DTYPE)
+        with np.errstate(all="ignore"):
+            rec["x"] = x_deg.astype(np.float32)
+        out = self.loop.step(rec)
+        return out["torque"][0].astype(float), bool(out["status"][0] & dp_golden.STATUS_INVALID)
+
+
+class DpController:
+    def __init__(self, name: str, law, torque_limit: float, control_period: float):
+        self.name, self.law = name, law
+        self.cfg = flight_config(torque_limit, control_period)
+        self.envelope = table2_envelope()
+        self.modes = ModeLogic(self.cfg.dwell_steps)
+        self.pid = TrackingPid(self.cfg)
+
+    def reset(self) -> None:
+        self.modes.reset()
+        self.pid.reset()
+
+    def step(self, m: Measurement) -> ControlOutput:
+        valid = measurement_finite(m)
+        with np.errstate(all="ignore"):
+            x = preprocess(m)
+            x_deg = x.network_inputs_deg()
+        status = bound_flags(self.envelope, x_deg) | (0 if valid else cs.STATUS_INPUT_INVALID)
+        mode = self.modes.update(status == 0)
+        raw = self.pid.step(x.A_bd / DEG, x.omega_e / DEG)
+        if mode == cs.MODE_NN:
+            law, invalid = self.law(x_deg)
+            if invalid:
+                status |= cs.STATUS_PID | cs.STATUS_INPUT_INVALID
+            else:
+                raw = law
+        else:
+            status |= cs.STATUS_PID | (cs.STATUS_DWELL if status == 0 else 0)
+        torque = clip_torque(raw, self.cfg.torque_limit)
+        return ControlOutput(torque=torque, mode="pid" if status & cs.STATUS_PID else "dp",
+                             info={"A_bd": x.A_bd, "omega_e": x.omega_e, "status": status})
+
+
+def _tables(tables: str | None) -> dp_tables.DpTables:
+    if tables is None:
+        raise HostError("the discrete-point controllers need tables= (a file written by `staregen dp build`)")
+    return load_tables(str(tables))
+
+
+def make_dp_controller(*, torque_limit: float, control_period: float, tables: str | None = None):
+    return DpController("dp", Float64Law(_tables(tables)), torque_limit, control_period)
+
+
+def make_dp_sil_controller(*, torque_limit: float, control_period: float, tables: str | None = None):
+    return DpController("dp-c", GeneratedLaw(_tables(tables)), torque_limit, control_period)
