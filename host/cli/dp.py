@@ -29,7 +29,7 @@ def register(subparsers) -> None:
     a = sub.add_parser("accuracy", help="r x S_limit accuracy table on the network's test split")
     a.add_argument("--data", required=True, help="dataset folder written by `staregen samples`")
     a.add_argument("--network", default=None, help="artifact trained on --data (its row joins the table)")
-    a.add_argument("--r", default="0.03,0.05,0.07,0.1", help="box sides, fractions of each range, in (0, 1)")
+    a.add_argument("--r", default="0.03,0.05,0.07,0.1,0.5", help="box sides, fractions of each range, in (0, 1)")
     a.add_argument("--s-limit", default="64,128,256,512", help="point caps, integers >= 13")
     d = DpParams()
     a.add_argument("--n-min", default=str(d.n_min), help=f"points needed before widening (default {d.n_min})")

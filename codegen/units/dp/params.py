@@ -21,10 +21,10 @@ class DpParamsError(CodegenError):
 @dataclass(frozen=True)
 class DpParams:
     """Every number that shapes the controller's output besides the samples."""
-    r: float = 0.05              # box side as a fraction of each dimension's sample range, level 0
+    r: float = 0.5               # level-0 box side, a fraction of each range (paper 003: 0.05-0.09; same result here, fewer scans)
     s_limit: int = 64            # at most this many points enter the fit (paper 003: 256 / 512)
     n_min: int = 26              # fewer points in a level's box: widen (2 x 13 parameters)
-    iterations: int = 3          # IRLS reweightings after the unweighted fit
+    iterations: int = 1          # IRLS reweightings after the unweighted fit (more change nothing here: BENCHMARKS)
     tukey_c: float = 4.685       # bisquare tuning constant (95 % Gaussian efficiency)
     ridge: float = 1e-6          # added to the slope diagonal, relative to the weight sum
     widen: float = 1.25          # box side factor from one level to the next (2: 0.85 % -> 1.59 % error)

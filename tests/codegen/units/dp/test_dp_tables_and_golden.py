@@ -91,6 +91,9 @@ def test_non_finite_or_constant_samples_are_refused():
 
 
 def test_golden_selects_what_the_float64_law_selects_and_agrees_to_float32(tables):
+    """Bound stated: on local fits 95 % of the rows within 3e-5 of the torque range and every row
+    within 1e-3 (a Tukey weight at its cut-off can flip between float32 and float64); global fits up
+    to two ranges outside within 1 % of the row's torque; the same level and count on >= 90 %."""
     c = g.Constants(tables)
     rows = np.concatenate([v[:60] for v in gate_inputs(tables, 600, seed=5).values()])
     rows = rows[np.all(np.isfinite(rows), axis=1) & np.all(np.abs(rows) < 10, axis=1)]
@@ -98,19 +101,21 @@ def test_golden_selects_what_the_float64_law_selects_and_agrees_to_float32(table
     inp["x"] = rows
     out = g.step(c, inp)
     law = DpModel.fit(tables.X.astype(float), tables.Y.astype(float), tables.params)
-    same = 0
+    span = np.abs(tables.Y).max()
+    same, local = 0, []
     for r, o in zip(rows, out):
         res = law.query(r.astype(float))
-        if res.level == o["level"] and res.found == o["found"]:
-            same += 1
-            if res.level < tables.n_levels:      # a local fit: float32 normal equations (~1e-4 of the torque range)
-                assert np.allclose(o["torque"], res.torque, rtol=0, atol=1e-4 * np.abs(tables.Y).max())
-            elif np.all(np.abs(r - tables.X.mean(0)) <= 2 * tables.span):
-                # a global fit extrapolated up to two ranges outside: 1 % of the row's torque (farther
-                # out the affine extrapolation amplifies float32 rounding without bound; not compared)
-                assert np.allclose(o["torque"], res.torque, rtol=0, atol=1e-2 * np.abs(res.torque).max())
-    # float32 box edges may differ from float64 ones on the window rows: the rest must agree
-    assert same >= 0.9 * len(rows)
+        if res.level != o["level"] or res.found != o["found"]:
+            continue        # float32 box edges differ from float64 ones on some window rows
+        same += 1
+        if res.level < tables.n_levels:
+            local.append(np.abs(o["torque"] - res.torque).max() / span)
+        elif np.all(np.abs(r - tables.X.mean(0)) <= 2 * tables.span):
+            # farther out the affine extrapolation amplifies float32 rounding without bound: not compared
+            assert np.allclose(o["torque"], res.torque, rtol=0, atol=1e-2 * np.abs(res.torque).max())
+    local = np.array(local)
+    assert same >= 0.9 * len(rows) and len(local) > 100
+    assert np.percentile(local, 95) < 3e-5 and local.max() < 1e-3
 
 
 def test_vectorised_reservoir_equals_the_sequential_algorithm(tables):
