@@ -5,7 +5,8 @@ samples on Dask (<out>/samples/, the `regularised` objective); training of the 1
 network on them (<out>/network.json, <out>/training.md); the generated C (<out>/c/); the three-way bit-exact gate (golden == x86 ==
 ARM); the Cortex-M4 cycle summary in the three memory modes (<out>/cycles.json, cycles.md); the
 flight package of the whole Fig. 2 controller with the default configuration (<out>/package,
-<out>/controller.toml); small presets of PID tuning (<out>/tune), evaluation (<out>/evaluate) and
+<out>/controller.toml); small presets of PID tuning (<out>/tune), the discrete-point tables of paper 003
+(<out>/dp_tables.json), evaluation (<out>/evaluate, the discrete-point law among the controllers) and
 their report (<out>/report/report.md, report.html); a summary (report.json, report.txt). The output folder is built atomically: a failed stage leaves
 no partial folder.
 """
@@ -190,9 +191,28 @@ def stage_tune(ctx: PipelineContext) -> None:
                       f"{doc['check']['table1']['J']:.3e}, tuned {doc['check']['tuned']['J']:.3e}")
 
 
+def stage_dp(ctx: PipelineContext) -> None:
+    """The discrete-point controller's tables (paper 003) from the training split of the samples
+    (<out>/dp_tables.json), default settings; it flies in the evaluation next."""
+    from codegen.units.dp import tables as dp_tables
+    from codegen.units.dp.params import DpParams
+    from host.learn import training
+
+    X, Y, _ = training.load_training_data(ctx.out / "samples")
+    split = training.make_split(X, Y, PRESET_SEED)
+    t = dp_tables.from_arrays(split.X_train, split.Y_train, DpParams(), {
+        "creator": "staregen pipeline", "seed": PRESET_SEED, "dataset_sha256": training.dataset_sha256(X, Y)})
+    t.save(ctx.out / "dp_tables.json")
+    ctx.results["dp"] = {"tables": "dp_tables.json", "samples": t.n, "flash_bytes": t.flash_bytes,
+                         "levels": t.n_levels, "sha256": t.sha256}
+    ctx.report.append(f"discrete point (paper 003): {t.n} anchor samples, {t.flash_bytes:,} bytes of flash, "
+                      f"{t.n_levels} box levels -> {ctx.final / 'dp_tables.json'}")
+
+
 def stage_evaluate(ctx: PipelineContext) -> None:
-    """NN (float64, SIL, PIL on the central target), Table 1 and tuned PID, PD+FF: staring, step,
-    frequency and impulse responses on a small preset (<out>/evaluate), then the report (<out>/report)."""
+    """NN (float64, SIL, PIL on the central target), Table 1 and tuned PID, PD+FF, the discrete-point
+    law (float64, SIL): staring, step, frequency and impulse responses on a small preset
+    (<out>/evaluate), then the report (<out>/report)."""
     from host.cli.evaluate import summary
     from host.cli.tune import parse_targets
     from host.tune import figures
@@ -209,7 +229,9 @@ def stage_evaluate(ctx: PipelineContext) -> None:
              ControllerSpec("NN (float64)", "nn", (("artifact", net),)),
              ControllerSpec("NN (SIL, x86 C)", "nn-c", (("artifact", net),)),
              ControllerSpec("NN (PIL, ARM, central)", "nn-arm", (("artifact", net),)),
-             ControllerSpec("PD+FF", "pdff", (("baselines", laws),))]
+             ControllerSpec("PD+FF", "pdff", (("baselines", laws),)),
+             ControllerSpec("DP (float64)", "dp", (("tables", str(ctx.out / "dp_tables.json")),)),
+             ControllerSpec("DP (SIL, x86 C)", "dp-c", (("tables", str(ctx.out / "dp_tables.json")),))]
     folder = ctx.out / "evaluate"
     result = figures.write_evaluation(evaluate(plan, specs, progress=False), net, PRESET_SEED, folder)
     write_report(ctx.out / "report", folder, ctx.out / "tune", ["staregen pipeline (small presets of tune pid, "
@@ -227,7 +249,7 @@ def stage_report(ctx: PipelineContext) -> None:
 
 
 STAGES = [stage_scenario, stage_pid_central, stage_samples, stage_train, stage_codegen, stage_gate, stage_cycles,
-          stage_package, stage_tune, stage_evaluate, stage_report]
+          stage_package, stage_tune, stage_dp, stage_evaluate, stage_report]
 # The package's evidence at pipeline scale (the standalone `staregen generate` defaults measure more).
 PACKAGE_PLAN = EvidencePlan(gate_vectors=20_000, gate_sequences=4, sequence_steps=200, selftest_vectors=256,
                             cycles_per_class=20, seed=PRESET_SEED)
