@@ -7,8 +7,8 @@ Offline (once, `DpTables.build`): per input dimension k the sorted sample values
 IDs in that order X3[:, k] (a stable argsort) and the range R_k = max − min (paper 003 §3).
 
 Per query q (12 inputs in Table 2 units, `DpModel.query`):
-  1. levels l = 0, 1, ...: box half-widths h_k = (r·2^l / 2)·R_k (side r·2^l of the range); the
-     last level takes every sample;
+  1. levels l = 0, 1, ...: box half-widths h_k = (r·widen^l / 2)·R_k (side r·widen^l of the range,
+     while below 2 ranges); the last level takes every sample;
   2. per level, bisection of each X2 column for [q_k − h_k, q_k + h_k] (closed), the dimension with
      the fewest candidates k* (lowest k on ties) scanned in X2 order, each candidate kept when all
      12 coordinates lie in the box; the first level with at least n_min points is used;
@@ -25,11 +25,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from codegen.units.dp.golden import XORSHIFT_SEED
 from codegen.units.dp.params import N_IN, N_OUT, N_PARAM, DpParams
+from codegen.units.dp.tables import MEAN_ABS_TO_SIGMA
 from host.errors import HostError
 
-XORSHIFT_SEED = 0x9E3779B9          # any non-zero 32-bit state; fixed so a query is a pure function
-MEAN_ABS_TO_SIGMA = 1.2533141373155  # sqrt(pi/2): E|e| = sigma·sqrt(2/pi) for Gaussian residuals
 
 
 @dataclass(frozen=True)
@@ -114,8 +114,25 @@ def select(t: DpTables, c: DpParams, q: np.ndarray) -> Neighbourhood:
     return Neighbourhood(reservoir(every, c.s_limit), t.n, len(sides))
 
 
+def _solve_or_mean(A: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, bool]:
+    """The system's solution, or (as the C's LDLᵀ on a pivot that is not positive) the weighted
+    mean b0 / A00 with zero slopes and singular = True."""
+    try:
+        np.linalg.cholesky(A)
+        beta = np.linalg.solve(A, b)
+        if np.all(np.isfinite(beta)):
+            return beta, False
+    except np.linalg.LinAlgError:
+        pass
+    beta = np.zeros(N_PARAM)
+    with np.errstate(all="ignore"):
+        beta[0] = b[0] / A[0, 0]
+    return beta, True
+
+
 def irls_intercept(Z: np.ndarray, y: np.ndarray, c: DpParams) -> float:
-    """Step 4 for one output: the affine IRLS fit's value at the query (Z: (m, 12) scaled offsets)."""
+    """Step 4 for one output: the affine IRLS fit's value at the query (Z: (m, 12) scaled offsets);
+    NaN when even the weighted mean is undefined (the caller's invalid case)."""
     Phi = np.hstack([np.ones((len(Z), 1)), Z])
     w = np.ones(len(Z))
     beta = np.zeros(N_PARAM)
@@ -128,8 +145,10 @@ def irls_intercept(Z: np.ndarray, y: np.ndarray, c: DpParams) -> float:
             u = e / (c.tukey_c * scale)
             w = np.where(np.abs(u) < 1.0, (1.0 - u * u) ** 2, 0.0)
         A = Phi.T @ (w[:, None] * Phi)
-        A[1:, 1:] += np.eye(N_IN) * (c.ridge * max(float(np.sum(w)), 1e-300))
-        beta = np.linalg.solve(A, Phi.T @ (w * y))
+        A[1:, 1:] += np.eye(N_IN) * (c.ridge * float(np.sum(w)))
+        beta, singular = _solve_or_mean(A, Phi.T @ (w * y))
+        if singular:
+            break
     return float(beta[0])
 
 

@@ -43,7 +43,11 @@ class Float64Law:
     def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
         if not np.all(np.isfinite(x_deg)):
             return np.zeros(3), True
-        return self.model.query(x_deg).torque, False
+        with np.errstate(all="ignore"):
+            torque = self.model.query(x_deg).torque
+        if not np.all(np.isfinite(torque)):
+            return np.zeros(3), True        # the C's STATUS_INVALID
+        return torque, False
 
 
 class GeneratedLaw:

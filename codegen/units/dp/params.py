@@ -12,6 +12,8 @@ N_IN, N_OUT = 12, 3
 N_PARAM = N_IN + 1            # affine fit: intercept + 12 slopes
 MAX_ITERATIONS = 20
 LAST_SIDE = 2.0               # a box of side 2·range centred inside the range holds every sample
+MAX_LEVELS = 64               # boxed levels at most (r and widen are refused beyond it)
+MAX_TUKEY_C = 1000.0
 
 
 class DpParamsError(CodegenError):
@@ -31,7 +33,12 @@ class DpParams:
 
     def validate(self) -> "DpParams":
         def number(x) -> bool:
-            return isinstance(x, float | int) and not isinstance(x, bool) and math.isfinite(x)
+            if not isinstance(x, float | int) or isinstance(x, bool):
+                return False
+            try:
+                return math.isfinite(float(x))
+            except OverflowError:       # a JSON integer of hundreds of digits
+                return False
 
         def integer(x) -> bool:
             return isinstance(x, int) and not isinstance(x, bool)
@@ -48,15 +55,20 @@ class DpParams:
                                 f"got {self.iterations}")
         if not (number(self.widen) and 1.0 < self.widen <= 4.0):
             raise DpParamsError(f"discrete-point widening factor must lie in (1, 4], got {self.widen}")
-        if not (number(self.tukey_c) and self.tukey_c > 0 and number(self.ridge) and 0 <= self.ridge <= 1):
-            raise DpParamsError("discrete-point tukey_c must be > 0 and ridge in [0, 1] (finite)")
+        levels = math.ceil((math.log(LAST_SIDE) - math.log(self.r)) / math.log(self.widen))
+        if levels > MAX_LEVELS:
+            raise DpParamsError(f"discrete-point r = {self.r:g} and widen = {self.widen:g} give {levels} box levels; "
+                                f"at most {MAX_LEVELS} (raise r or widen)")
+        if not (number(self.tukey_c) and 0 < self.tukey_c <= MAX_TUKEY_C and number(self.ridge)
+                and 0 <= self.ridge <= 1):
+            raise DpParamsError(f"discrete-point tukey_c must lie in (0, {MAX_TUKEY_C:g}] and ridge in [0, 1]")
         return self
 
     def sides(self) -> tuple[float, ...]:
         """Box sides (fractions of the range) of the boxed levels: r·widen^l while below 2; after
         them a last level takes every sample."""
         out, side = [], float(self.r)
-        while side < LAST_SIDE:
+        while side < LAST_SIDE and len(out) < MAX_LEVELS:
             out.append(side)
             side *= float(self.widen)
         return tuple(out)

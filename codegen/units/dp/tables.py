@@ -45,8 +45,8 @@ MEAN_ABS_TO_SIGMA = 1.2533141373155003   # sqrt(pi/2): E|e| = sigma·sqrt(2/pi) 
 
 def stack_estimate(s_limit: int) -> int:
     """The step's stack: per selected point its ID (uint16) and one residual / weight (float32); the
-    13 x 13 system, its factor and the box (about 2 KiB). The cycle report measures the real figure."""
-    return s_limit * (2 + 4) + 2048
+    13 x 13 system, its factor and the box (about 3.5 KiB; 4 KiB counted). The cycle report measures the real figure."""
+    return s_limit * (2 + 4) + 4096
 
 
 def flash_problem(n: int) -> str | None:
@@ -221,8 +221,8 @@ def from_document(doc, source: str | None = None) -> DpTables:
     problem = flash_problem(n)
     if problem:
         fail("payload.samples.n", problem)
-    X, Y = _decode(s["x"], "payload.samples.x", n, N_IN), _decode(s["y"], "payload.samples.y", n, N_OUT)
     try:
+        X, Y = _decode(s["x"], "payload.samples.x", n, N_IN), _decode(s["y"], "payload.samples.y", n, N_OUT)
         return DpTables(X, Y, params, p["metadata"])
     except ArtifactError as exc:
         raise ArtifactError(exc.field_path, exc.reason, source) from None

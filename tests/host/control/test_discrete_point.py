@@ -96,3 +96,12 @@ def test_bad_samples_are_refused():
     X[:, 4] = 1.0
     with pytest.raises(HostError, match="constant input dimension 4"):
         DpModel.fit(X, Y)
+
+
+def test_a_singular_system_gives_the_weighted_mean_like_the_c():
+    """ridge 0 and every point equal in one input: the C's LDLᵀ meets a zero pivot and returns the
+    weighted mean; the float64 law does the same instead of raising."""
+    Z = np.random.default_rng(5).uniform(-0.5, 0.5, (40, 12))
+    Z[:, 3] = 0.0
+    y = np.linspace(1.0, 2.0, 40)
+    assert irls_intercept(Z, y, DpParams(ridge=0.0, iterations=2)) == pytest.approx(1.5, abs=1e-12)

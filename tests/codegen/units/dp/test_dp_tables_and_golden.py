@@ -148,3 +148,26 @@ def test_window_rows_put_a_box_edge_exactly_on_a_sample(tables):
         on_edge += any(np.isin(lo[:, k], tables.X[:, k]).any() or np.isin(hi[:, k], tables.X[:, k]).any()
                        for k in range(12))
     assert on_edge >= 0.95 * len(x)
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda p: p.update(r=10 ** 400), "r must lie in (0, 1)"),                  # a JSON integer too big for a float
+    (lambda p: p.update(r=5e-324, widen=1.0000000000000002), "box levels; at most 64"),
+    (lambda p: p.update(r=0.5, widen=1.0000000000000002), "box levels; at most 64"),
+    (lambda p: p.update(tukey_c=3e38), "tukey_c must lie in (0, 1000]"),
+])
+def test_settings_that_would_hang_or_overflow_are_refused(tables, tmp_path, edit, message):
+    d = _doc(tables)
+    edit(d["payload"]["params"])
+    (tmp_path / "t.json").write_text(json.dumps(_sealed(d["payload"])))
+    with pytest.raises(ArtifactError) as e:
+        T.load(tmp_path / "t.json")
+    assert message in str(e.value) and "\n" not in str(e.value) and str(tmp_path) in str(e.value)
+
+
+def test_bad_base64_names_the_file(tables, tmp_path):
+    d = _doc(tables)
+    d["payload"]["samples"]["y"] = "!!!!"
+    (tmp_path / "t.json").write_text(json.dumps(_sealed(d["payload"])))
+    with pytest.raises(ArtifactError, match="t.json: payload.samples.y: not valid base64"):
+        T.load(tmp_path / "t.json")
