@@ -23,7 +23,7 @@ from host.learn.discrete_point_sweep import markdown, sweep
 
 
 def register(subparsers) -> None:
-    p = subparsers.add_parser("dp", help="the discrete-point controller (paper 003): host accuracy",
+    p = subparsers.add_parser("dp", help="the discrete-point controller (paper 003): host accuracy, flight tables",
                               description=__doc__.splitlines()[0])
     sub = p.add_subparsers(dest="dp_command", required=True, metavar="ACTION")
     a = sub.add_parser("accuracy", help="r x S_limit accuracy table on the network's test split")
@@ -65,7 +65,7 @@ def accuracy_main(args) -> int:
     base = DpParams(n_min=parse_int(args.n_min, "--n-min", 1), widen=parse_number(args.widen, "--widen"),
                     s_limit=max(s_limits))
     for r in rs:
-        DpParams(r=r).validate()
+        DpParams(r=r, widen=base.widen).validate()
     for s in s_limits:
         DpParams(s_limit=s, n_min=min(base.n_min, s)).validate()
     base.validate()
