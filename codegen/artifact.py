@@ -283,8 +283,7 @@ class Artifact:
         return payload_sha256(self.payload())
 
     def document(self) -> dict:
-        payload = self.payload()
-        return {"format": FORMAT, "version": VERSION, "sha256": payload_sha256(payload), "payload": payload}
+        return sealed(FORMAT, VERSION, self.payload())
 
     def to_json(self) -> str:
         return _pretty_json(self.document()) + "\n"
@@ -763,14 +762,27 @@ def from_document(doc: Any, source: str | None = None) -> Artifact:
     return artifact
 
 
-def _check_seal(r: _Reader, doc: dict) -> None:
+def sealed(format_: str, version: int, payload: dict) -> dict:
+    """A document of any sealed artifact format: its payload and the sha256 that seals it."""
+    return {"format": format_, "version": version, "sha256": payload_sha256(payload), "payload": payload}
+
+
+def seal_problem(doc: dict) -> str | None:
+    """Why a document's stated sha256 does not seal its payload (None when it does)."""
     stated = doc["sha256"]
     if not isinstance(stated, str) or not re.fullmatch(r"[0-9a-f]{64}", stated):
-        r.fail("sha256", f"expected 64 lowercase hex digits, got {stated!r}")
+        return f"expected 64 lowercase hex digits, got {str(stated)[:70]!r}"
     actual = payload_sha256(doc["payload"])
     if actual != stated:
-        r.fail("sha256", f"mismatch: the payload hashes to {actual}, the file states {stated} "
-                         "(payload modified after it was sealed)")
+        return (f"mismatch: the payload hashes to {actual}, the file states {stated} "
+                "(payload modified after it was sealed)")
+    return None
+
+
+def _check_seal(r: _Reader, doc: dict) -> None:
+    problem = seal_problem(doc)
+    if problem:
+        r.fail("sha256", problem)
 
 
 def read_document(path: str | os.PathLike):

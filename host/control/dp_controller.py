@@ -14,17 +14,12 @@ import functools
 import numpy as np
 
 from codegen.artifact import table2_envelope
-from codegen.units.controller import spec as cs
 from codegen.units.dp import golden as dp_golden
 from codegen.units.dp import tables as dp_tables
 from codegen.units.dp.unit import DpUnit
-from host.control.controllers import ControlOutput, Measurement
 from host.control.discrete_point import DpModel, DpTables as DpTables64
-from host.control.nn_controller import (ModeLogic, TrackingPid, bound_flags, clip_torque, flight_config,
-                                        measurement_finite)
-from host.core.constants import DEG
+from host.control.nn_controller import Fig2Controller, flight_config
 from host.errors import HostError
-from host.gnc.preprocess import preprocess
 from tools.inloop import InTheLoop
 
 
@@ -64,37 +59,15 @@ class GeneratedLaw:
         return out["torque"][0].astype(float), bool(out["status"][0] & dp_golden.STATUS_INVALID)
 
 
-class DpController:
+class DpController(Fig2Controller):
+    law_mode = "dp"
+
     def __init__(self, name: str, law, torque_limit: float, control_period: float):
-        self.name, self.law = name, law
-        self.cfg = flight_config(torque_limit, control_period)
-        self.envelope = table2_envelope()
-        self.modes = ModeLogic(self.cfg.dwell_steps)
-        self.pid = TrackingPid(self.cfg)
+        super().__init__(table2_envelope(), flight_config(torque_limit, control_period))
+        self.name, self._law = name, law
 
-    def reset(self) -> None:
-        self.modes.reset()
-        self.pid.reset()
-
-    def step(self, m: Measurement) -> ControlOutput:
-        valid = measurement_finite(m)
-        with np.errstate(all="ignore"):
-            x = preprocess(m)
-            x_deg = x.network_inputs_deg()
-        status = bound_flags(self.envelope, x_deg) | (0 if valid else cs.STATUS_INPUT_INVALID)
-        mode = self.modes.update(status == 0)
-        raw = self.pid.step(x.A_bd / DEG, x.omega_e / DEG)
-        if mode == cs.MODE_NN:
-            law, invalid = self.law(x_deg)
-            if invalid:
-                status |= cs.STATUS_PID | cs.STATUS_INPUT_INVALID
-            else:
-                raw = law
-        else:
-            status |= cs.STATUS_PID | (cs.STATUS_DWELL if status == 0 else 0)
-        torque = clip_torque(raw, self.cfg.torque_limit)
-        return ControlOutput(torque=torque, mode="pid" if status & cs.STATUS_PID else "dp",
-                             info={"A_bd": x.A_bd, "omega_e": x.omega_e, "status": status})
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
+        return self._law(x_deg)
 
 
 def _tables(tables: str | None) -> dp_tables.DpTables:

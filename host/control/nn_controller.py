@@ -129,17 +129,22 @@ class TrackingPid:
         return raw
 
 
-class NnController:
-    """Fig. 2 in float64 (name "nn"): network inside the envelope, PID fallback, saturation."""
+class Fig2Controller:
+    """The controller of Fig. 2 around a law of the 12 Table 2 inputs: the law inside the envelope
+    (after the dwell), the Table 1 PID outside it, on a non-finite measurement or when the law
+    reports its input invalid; then saturation. Subclasses give `law` and the envelope."""
 
-    name = "nn"
+    name = "fig2"
+    law_mode = "law"           # ControlOutput.mode while the law flies
 
-    def __init__(self, artifact: art.Artifact, cfg: cs.ControllerConfig):
-        if artifact.sizes[0] != 12 or artifact.sizes[2] != 3:
-            raise HostError(f"the network controller needs a 12-input, 3-output network, got {artifact.shape_text}")
-        self.artifact, self.cfg = artifact, cfg
+    def __init__(self, envelope: art.Envelope, cfg: cs.ControllerConfig):
+        self.envelope, self.cfg = envelope, cfg
         self.modes = ModeLogic(cfg.dwell_steps)
         self.pid = TrackingPid(cfg)
+
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
+        """(torque N·m, input invalid) for the 12 inputs in Table 2 units."""
+        raise NotImplementedError
 
     def reset(self) -> None:
         self.modes.reset()
@@ -150,18 +155,38 @@ class NnController:
         with np.errstate(all="ignore"):
             x = preprocess(m)
             x_deg = x.network_inputs_deg()
-        status = bound_flags(self.artifact.envelope, x_deg) | (0 if valid else cs.STATUS_INPUT_INVALID)
+        status = bound_flags(self.envelope, x_deg) | (0 if valid else cs.STATUS_INPUT_INVALID)
         mode = self.modes.update(status == 0)
         raw = self.pid.step(x.A_bd / DEG, x.omega_e / DEG)
         if mode == cs.MODE_NN:
-            raw = network64(self.artifact, x_deg)
+            law, invalid = self.law(x_deg)
+            if invalid:
+                status |= cs.STATUS_PID | cs.STATUS_INPUT_INVALID
+            else:
+                raw = law
         else:
             status |= cs.STATUS_PID | (cs.STATUS_DWELL if status == 0 else 0)
         torque = clip_torque(raw, self.cfg.torque_limit)
         if np.any(torque != raw):
             status |= cs.STATUS_SATURATED
-        return ControlOutput(torque=torque, mode="nn" if mode == cs.MODE_NN else "pid",
+        return ControlOutput(torque=torque, mode="pid" if status & cs.STATUS_PID else self.law_mode,
                              info={"A_bd": x.A_bd, "omega_e": x.omega_e, "status": status})
+
+
+class NnController(Fig2Controller):
+    """Fig. 2 in float64 (name "nn"): network inside the envelope, PID fallback, saturation."""
+
+    name = "nn"
+    law_mode = "nn"
+
+    def __init__(self, artifact: art.Artifact, cfg: cs.ControllerConfig):
+        if artifact.sizes[0] != 12 or artifact.sizes[2] != 3:
+            raise HostError(f"the network controller needs a 12-input, 3-output network, got {artifact.shape_text}")
+        self.artifact = artifact
+        super().__init__(artifact.envelope, cfg)
+
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, bool]:
+        return network64(self.artifact, x_deg), False
 
 
 @functools.lru_cache(maxsize=4)

@@ -29,7 +29,7 @@ import numpy as np
 
 from codegen import atomic
 from codegen.artifact import (TABLE2_MAX, TABLE2_MIN, ArtifactError, comment_text_problem, payload_sha256,
-                               read_document)
+                               read_document, seal_problem, sealed)
 from codegen.units.dp.params import N_IN, N_OUT, DpParams, DpParamsError
 
 FORMAT = "staregen.dp-tables"
@@ -103,8 +103,7 @@ class DpTables:
         return payload_sha256(self.payload())
 
     def document(self) -> dict:
-        payload = self.payload()
-        return {"format": FORMAT, "version": VERSION, "sha256": payload_sha256(payload), "payload": payload}
+        return sealed(FORMAT, VERSION, self.payload())
 
     def save(self, path: str | os.PathLike) -> Path:
         return atomic.write_text(path, json.dumps(self.document(), indent=1) + "\n")
@@ -200,11 +199,9 @@ def from_document(doc, source: str | None = None) -> DpTables:
     p = doc["payload"]
     if not isinstance(p, dict) or set(p) != {"params", "samples", "metadata"}:
         fail("payload", "expected an object with params, samples, metadata")
-    stated = doc["sha256"]
-    if not isinstance(stated, str) or not re.fullmatch(r"[0-9a-f]{64}", stated):
-        fail("sha256", "expected 64 lowercase hex digits")
-    if payload_sha256(p) != stated:
-        fail("sha256", "mismatch: the payload was modified after it was sealed")
+    problem = seal_problem(doc)
+    if problem:
+        fail("sha256", problem)
     if not isinstance(p["params"], dict) or set(p["params"]) != set(DpParams().to_dict()):
         fail("payload.params", f"expected exactly the keys {', '.join(sorted(DpParams().to_dict()))}")
     params = DpParams(**p["params"])

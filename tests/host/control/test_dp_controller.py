@@ -46,10 +46,10 @@ def test_the_law_flies_like_the_network_it_was_sampled_from(tables_file):
 
 
 def test_sil_equals_its_golden_model_and_the_float64_law_within_one_percent(tables_file):
-    sil_controller = DpController("dp-c", GeneratedLaw(load_tables(tables_file), golden_twin=True), 1.0, 0.1)
-    sil, _ = _fly(sil_controller)
+    generated = GeneratedLaw(load_tables(tables_file), golden_twin=True)
+    sil, _ = _fly(DpController("dp-c", generated, 1.0, 0.1))
     dp, _ = _fly(make_dp_controller(torque_limit=1.0, control_period=0.1, tables=tables_file))
-    assert sil_controller.law.loop.mismatch_steps == 0 and len(sil_controller.law.loop.outputs) > 100
+    assert generated.loop.mismatch_steps == 0 and len(generated.loop.outputs) > 100
     assert sil.J == pytest.approx(dp.J, rel=0.01)
 
 
