@@ -41,7 +41,8 @@ class Batch(NamedTuple):
 class Budgets:
     """SPEC section 8 budgets of one unit (None: no budget stated for that figure)."""
 
-    cycles: int | None = None     # worst case of the step, ideal memory
+    cycles: int | None = None     # worst case of the step, ideal memory (strict table, static bound)
+    cycles_art: int | None = None  # the same with flash wait states and the ART accelerator
     flash: int | None = None      # bytes of the unit's objects (code + constants)
     ram: int | None = None        # static RAM + the caller-owned state
     stack: int | None = None      # worst-case stack of the step

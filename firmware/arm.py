@@ -35,8 +35,8 @@ ADAPTERS = HERE / "adapters"
 BENCH = HERE / "bench"
 ARM_NM = "arm-none-eabi-nm"
 ARM_SIZE = "arm-none-eabi-size"
-EXTRA_CFLAGS = ["-fstack-usage", "-ffunction-sections", "-fdata-sections"]
-BUILD_LAYOUT = "2"   # 2: the manifest holds the ELF's sha256, checked before use
+EXTRA_CFLAGS = ["-g", "-fstack-usage", "-ffunction-sections", "-fdata-sections"]
+BUILD_LAYOUT = "3"   # 2: the manifest holds the ELF sha256, checked before use; 3: -g (line table for loop bounds)
 
 # Names that would mean libm (or a vendor HAL) got linked in.
 _LIBM, _HAL = symbols.LIBM, symbols.HAL
@@ -108,7 +108,10 @@ def _compile(src: Path, obj_dir: Path, opt: str, peer: bool) -> list[Path]:
     objects = []
     for c_file in sorted(src.glob("*.c")):
         obj = obj_dir / (c_file.stem + ".o")
-        res = _run([cc, *cflags(opt, peer), "-I", str(src), "-c", str(c_file), "-o", str(obj)], "compile")
+        # The line table names the sources relative to the build folder, so a rebuild in another
+        # temporary folder gives the same bytes (the cached ELF is checked against its hash).
+        res = _run([cc, *cflags(opt, peer), f"-fdebug-prefix-map={src.parent}=.", "-I", str(src), "-c",
+                    str(c_file), "-o", str(obj)], "compile")
         if res.returncode != 0:
             raise FirmwareError(f"ARM build: {c_file.name} does not compile: {_one_line(res.stderr)}")
         objects.append(obj)
@@ -230,7 +233,7 @@ def bench_build(out_dir: Path) -> Path:
     out_dir.mkdir(parents=True, exist_ok=True)
     elf = out_dir / "bench.elf"
     sources = sorted(str(p) for p in BENCH.glob("*.S"))
-    cmd = [tool(ARM_CC), *ARM_CPU, "-I", str(BENCH), "-nostartfiles", "-nostdlib",
+    cmd = [tool(ARM_CC), *ARM_CPU, "-g", "-I", str(BENCH), "-nostartfiles", "-nostdlib",
            "-T", str(LINKER_SCRIPT), "-Wl,-e,0", "-o", str(elf), *sources]
     res = _run(cmd, "assemble")
     if res.returncode != 0:

@@ -15,11 +15,13 @@ if ! command -v arm-none-eabi-gcc >/dev/null 2>&1 \
 fi
 
 # cmake builds the flight package with its own CMakeLists (staregen generate, package check, tests);
-# cppcheck with its MISRA addon checks the generated C (staregen misra).
-if ! command -v cmake >/dev/null 2>&1 || ! command -v cppcheck >/dev/null 2>&1; then
-  echo "setup: installing cmake and cppcheck (apt)"
+# cppcheck with its MISRA addon checks the generated C (staregen misra); llvm gives llvm-mca, the
+# lower bound the cycle model's block costs are checked against (tools/m4/mca.py).
+if ! command -v cmake >/dev/null 2>&1 || ! command -v cppcheck >/dev/null 2>&1 \
+   || [ -z "$(compgen -c llvm-mca)" ]; then
+  echo "setup: installing cmake, cppcheck and llvm (apt)"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck llvm >/dev/null
 fi
 
 stamp=.setup-stamp

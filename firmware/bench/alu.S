@@ -1,7 +1,8 @@
 #include "common.inc"
 
 @ bench: bench_alu_chain
-@ expect: 13
+@ lenient: 13
+@ strict: 13
 @   movs, adds, eors, lsls, subs          5 x 1 (ALU)                = 5
 @   mul, mla                              2 x 1 (MUL/MLA)            = 2
 @   orr, and, cmp                         3 x 1 (ALU)                = 3

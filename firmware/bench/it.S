@@ -1,7 +1,8 @@
 #include "common.inc"
 
 @ bench: bench_it_blocks
-@ expect: 20
+@ lenient: 20
+@ strict: 20
 @ Instructions skipped inside an IT block cost 1 (Unicorn runs no hook for them).
 @   movs r1, #0 ; cmp r1, #0              2 x 1                      = 2
 @   ite eq                                1                          = 1

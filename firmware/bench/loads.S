@@ -1,9 +1,12 @@
 #include "common.inc"
 
 @ bench: bench_loads_dependent
-@ expect: 9
+@ lenient: 9
+@ strict: 9
 @   ldr r1, [r0]                          2 (LDR)                    = 2
 @   ldr r2, [r1]                          2 (address is the result of the previous load: no pipelining) = 2
+@                                         strict: the same (the AGU stall is for an address an ALU
+@                                         instruction computed; a load result is this rule)
 @   ldr r3, [r2]                          2 (same)                   = 2
 @   bx lr                                 1 + P                      = 3
 BENCH bench_loads_dependent
@@ -14,11 +17,13 @@ BENCH bench_loads_dependent
 END bench_loads_dependent
 
 @ bench: bench_loads_independent
-@ expect: 11
+@ lenient: 11
+@ strict: 12
 @   ldr r1, [r0]                          2 (LDR)                    = 2
 @   ldr r2, [r0, #4]                      1 (independent load after a load pipelines: 2 - 1) = 1
 @   ldr r3, [r0, #8]                      1 (same)                   = 1
 @   str r1, [r0, #12]                     1 (store after a load pipelines: 2 - 1) = 1
+@                                         strict: 1 (STR, TRM 3.3.3), + 1 (the next one loads) = 2
 @   ldr r1, [r0, #16]                     2 (nothing pipelines after a store) = 2
 @   adds r2, r2, r3                       1 (ALU)                    = 1
 @   bx lr                                 1 + P                      = 3
@@ -33,10 +38,12 @@ BENCH bench_loads_independent
 END bench_loads_independent
 
 @ bench: bench_fp_loads
-@ expect: 9
+@ lenient: 9
+@ strict: 10
 @   vldr s0, [r0]                         2 (VLDR)                   = 2
 @   vldr s1, [r0, #4]                     1 (pipelined behind a load, as LDR) = 1
 @   vstr s0, [r0, #8]                     1 (store behind a load)    = 1
+@                                         strict: 1, + 1 (the next one loads) = 2
 @   vldr s2, [r0, #12]                    2 (nothing pipelines after a store) = 2
 @   bx lr                                 1 + P                      = 3
 BENCH bench_fp_loads
@@ -48,7 +55,8 @@ BENCH bench_fp_loads
 END bench_fp_loads
 
 @ bench: bench_ldm_stm
-@ expect: 27
+@ lenient: 27
+@ strict: 27
 @   push {r4-r7}                          1 + N, N = 4               = 5
 @   ldm r0, {r1-r3}                       1 + 3                      = 4
 @   stm r0, {r1-r3}                       1 + 3                      = 4
@@ -67,7 +75,8 @@ BENCH bench_ldm_stm
 END bench_ldm_stm
 
 @ bench: bench_vldm_vstm
-@ expect: 29
+@ lenient: 29
+@ strict: 29
 @   vpush {s16-s19}                       1 + N, N = 4               = 5
 @   vldm r0, {s0-s3}                      1 + 4                      = 5
 @   vstm r0, {s0-s3}                      1 + 4                      = 5

@@ -8,7 +8,9 @@ from unicorn import UcError
 
 from tools.errors import ToolError
 from tools.m4.elf import Image
-from tools.m4.timing import FLOW_COND, Cost, cost_of
+from capstone.arm_const import ARM_OP_IMM
+
+from tools.m4.timing import FLOW_COND, FLOW_NONE, Cost, cost_of, entry_extra, pair
 
 LINE_SHIFT = 4  # 128-bit flash lines (ART accelerator, flash read width)
 
@@ -19,6 +21,8 @@ class Insn:
     size: int
     text: str
     cost: Cost
+    target: int | None = None   # immediate branch or call target
+    conditional: bool = False   # condition code of its own (B<cond>); IT-conditional ones are not
 
 
 @dataclass
@@ -28,14 +32,16 @@ class Block:
     addr: int
     size: int
     n: int                # instructions, including ones an IT block may skip
-    cost: int             # zero-wait-state cycles when no IT instruction executes and no branch is taken
+    cost: int             # strict zero-wait-state cycles when no IT instruction executes and no branch is taken
+    cost_l: int           # the same under the lenient table
     fall: int             # fall-through address
     flow: int             # FLOW_* of the last instruction (tracker and taken penalty)
     cond_pen: int         # added when the last instruction is a conditional branch and is taken
     fid: int              # function index in Image.functions, -1 if none
     lines: tuple          # flash lines fetched, in order (empty outside flash)
-    tail_load: frozenset | None  # registers written by a final single load, if any
-    head_addr: frozenset | None  # address registers of a leading single load/store, if any
+    head: tuple           # (Cost, inside an IT block) of the first instruction
+    tail: tuple           # (Cost, inside an IT block) of the last instruction
+    entry_s: int          # strict cycles added when a taken branch lands here
 
 
 class Decoder:
@@ -63,7 +69,13 @@ class Decoder:
         decoded = next(self.cs.disasm(code, addr, 1), None)
         if decoded is None:
             raise ToolError(f"cannot decode the instruction at 0x{addr:08x}")
-        ins = Insn(addr, decoded.size, f"{decoded.mnemonic} {decoded.op_str}".strip(), cost_of(decoded))
+        cost = cost_of(decoded)
+        target = None
+        if cost.flow != FLOW_NONE:
+            imms = [op.imm for op in decoded.operands if op.type == ARM_OP_IMM]
+            target = imms[-1] if imms else None
+        ins = Insn(addr, decoded.size, f"{decoded.mnemonic} {decoded.op_str}".strip(), cost, target,
+                   cost.flow == FLOW_COND)
         self._insns[addr] = ins
         return ins
 
@@ -97,46 +109,51 @@ class Decoder:
             ins = self.insn(a)
             insns.append(ins)
             a += ins.size
-        return self._summarise(addr, size, insns)
+        return self.summarise(addr, size, insns)
 
-    def _summarise(self, addr: int, size: int, insns: list[Insn]) -> Block:
-        cost, it_left, prev_load, last_in_it = 0, 0, None, False
-        head_addr = None
-        for i, ins in enumerate(insns):
+    def summarise(self, addr: int, size: int, insns: list[Insn]) -> Block:
+        cost_s = cost_l = 0
+        it_left, prev, prev_it, head = 0, None, False, None
+        for ins in insns:
             c = ins.cost
             # Inside an IT block opened in this block, or (a block split by Unicorn) one
             # opened before it, as the static scan found.
-            last_in_it = it_left > 0 or ins.addr in self.it_scanned
-            if last_in_it:
+            in_it = it_left > 0 or ins.addr in self.it_scanned
+            if in_it:
                 # Charged 1 as if skipped; a code hook adds the rest when it executes.
                 it_left = max(it_left - 1, 0)
-                cost += 1
-                prev_load = None
-                continue
-            pipelined = c.ldst and prev_load is not None and not (c.addr_regs & prev_load)
-            cost += c.cycles - 1 if pipelined else c.cycles
-            if i == 0 and c.ldst:
-                head_addr = c.addr_regs
-            prev_load = c.load_writes if c.load else None
-            it_left = c.it_count
+                cost_s += 1
+                cost_l += 1
+            else:
+                cost_s += c.strict
+                cost_l += c.cycles
+                it_left = c.it_count
+            if prev is not None:
+                ds, dl = pair(prev, c, prev_it, in_it)
+                cost_s += ds
+                cost_l += dl
+            if head is None:
+                head = (c, in_it)
+            prev, prev_it = c, in_it
         last = insns[-1].cost
-        tail_load = last.load_writes if (last.load and not last_in_it) else None
-        cond_pen = last.taken_extra if (last.flow == FLOW_COND and not last_in_it) else 0
+        cond_pen = last.taken_extra if (last.flow == FLOW_COND and not prev_it) else 0
         lines = ()
         if self.flash[0] <= addr < self.flash[1]:
             lines = tuple(range(addr >> LINE_SHIFT, ((addr + size - 1) >> LINE_SHIFT) + 1))
-        return Block(addr, size, len(insns), cost, addr + size, last.flow, cond_pen,
-                     self.image.function_index(addr), lines, tail_load, head_addr)
+        return Block(addr, size, len(insns), cost_s, cost_l, addr + size, last.flow, cond_pen,
+                     self.image.function_index(addr), lines, head, (last, prev_it),
+                     entry_extra(insns[0].cost, addr))
 
-    def scan_it(self, start: int, size: int) -> dict[int, int]:
-        """IT-conditional instructions of a code range: {addr: extra cycles when executed}
-        (executed cost - 1, the skipped cost; an executed branch in an IT block is taken)."""
+    def scan_it(self, start: int, size: int) -> dict[int, tuple[int, int]]:
+        """IT-conditional instructions of a code range: {addr: (strict, lenient) extra cycles
+        when executed} (executed cost - 1, the skipped cost; an executed branch in an IT block
+        is taken)."""
         out, it_left = {}, 0
         for ins in self.linear(start, size):
             c = ins.cost
             if it_left:
                 it_left -= 1
-                out[ins.addr] = c.cycles + c.taken_extra - 1
+                out[ins.addr] = (c.strict + c.taken_extra - 1, c.cycles + c.taken_extra - 1)
                 continue
             it_left = c.it_count
         self.it_scanned.update(out)

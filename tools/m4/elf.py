@@ -39,7 +39,7 @@ class Image:
                     raise ToolError(f"{self.path}: not an ARM ELF (machine {elf['e_machine']})")
                 self.segments = [Segment(s["p_paddr"], s.data()) for s in elf.iter_segments()
                                  if s["p_type"] == "PT_LOAD" and s["p_filesz"] > 0]
-                self.symbols, funcs = _read_symbols(elf)
+                self.symbols, funcs, self.objects = _read_symbols(elf)
                 self.mapping = _read_mapping_symbols(elf)
                 self.sections = {s.name: (s["sh_addr"], s["sh_size"], s["sh_flags"], s["sh_type"])
                                  for s in elf.iter_sections() if s.name}
@@ -103,12 +103,14 @@ class Image:
         return struct.unpack("<I", self.read(self.symbol(name), 4))[0]
 
 
-def _read_symbols(elf) -> tuple[dict[str, int], list[Function]]:
+def _read_symbols(elf) -> tuple[dict[str, int], list[Function], list[Function]]:
+    """Symbols by name, functions, and data objects (STT_OBJECT with a size, as Function records)."""
     symtab = elf.get_section_by_name(".symtab")
     if symtab is None:
         raise ToolError("ELF has no symbol table (stripped?)")
     symbols: dict[str, int] = {}
     funcs: dict[int, Function] = {}
+    objects: list[Function] = []
     for s in symtab.iter_symbols():
         if not s.name or s["st_shndx"] == "SHN_UNDEF":
             continue
@@ -120,8 +122,10 @@ def _read_symbols(elf) -> tuple[dict[str, int], list[Function]]:
             prev = funcs.get(value)
             if prev is None or (s["st_info"]["bind"] == "STB_GLOBAL" and prev.size == 0):
                 funcs[value] = Function(s.name, value, s["st_size"])
+        elif kind == "STT_OBJECT" and s["st_size"]:
+            objects.append(Function(s.name, value, s["st_size"]))
         symbols.setdefault(s.name, value)
-    return symbols, list(funcs.values())
+    return symbols, list(funcs.values()), objects
 
 
 def _read_mapping_symbols(elf) -> list[tuple[int, str]]:

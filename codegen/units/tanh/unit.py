@@ -15,7 +15,7 @@ from codegen.units.tanh.emit import (DEFAULT_NAME, DEFAULT_PERIOD, INPUT_DTYPE, 
 from codegen.units.tanh.params import TanhParams
 
 # SPEC section 8 budget of the tanh-law step as this generator meets it (ideal memory).
-BUDGETS = Budgets(cycles=1_500, flash=None, ram=None, stack=512)
+BUDGETS = Budgets(cycles=1_200, flash=None, ram=None, stack=512)
 STATUS_NAMES = ("ok", "singular", "invalid")
 
 
