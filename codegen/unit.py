@@ -113,6 +113,9 @@ class Unit(ABC):
     # Emulator cap per step (a runaway loop ends in an error, not a hang); the network needs a few
     # thousand instructions, a unit that scans tables (dp) sets its own.
     max_instructions: int = 1_000_000
+    # Where the constant tables run on the STM32F417: "ccm" (64 KB of zero-wait-state data RAM,
+    # copied from flash at start-up) or "flash" (tables larger than CCM; every load may wait).
+    tables_in: str = "ccm"
 
     def __init__(self, entry: str, input_dtype: np.dtype, output_dtype: np.dtype,
                  state_dtype: np.dtype | None, budgets: Budgets):

@@ -118,8 +118,21 @@ def _compile(src: Path, obj_dir: Path, opt: str, peer: bool) -> list[Path]:
     return objects
 
 
+TABLE_PLACES = ("ccm", "flash")
+
+
+def linker_script(tables: str = "ccm") -> str:
+    """The STM32F417 linker script with the constant tables in CCM (copied at start-up) or, for
+    tables larger than CCM, left in flash."""
+    if tables not in TABLE_PLACES:
+        raise FirmwareError(f"constant tables go to one of {', '.join(TABLE_PLACES)}, not {tables!r}")
+    text = LINKER_SCRIPT.read_text()
+    return text if tables == "ccm" else text.replace("} > CCM AT > FLASH", "} > FLASH")
+
+
 def _link(objects: list[Path], elf: Path, map_file: Path, libs: list[str]) -> subprocess.CompletedProcess:
-    cmd = [tool(ARM_CC), *ARM_CPU, "-nostartfiles", "-nostdlib", "-T", str(LINKER_SCRIPT),
+    script = elf.parent / "link.ld"
+    cmd = [tool(ARM_CC), *ARM_CPU, "-nostartfiles", "-nostdlib", "-T", str(script),
            "-Wl,--gc-sections", f"-Wl,-Map={map_file}", "-o", str(elf), *map(str, objects), *libs]
     return _run(cmd, "link")
 
@@ -163,10 +176,11 @@ def check_symbols(elf: Path, allow_libm: bool = False) -> None:
         raise FirmwareError(f"ARM build: forbidden library symbols linked: {', '.join(bad[:5])}")
 
 
-def _build_into(folder: Path, files: Mapping[str, str], opt: str, peer: bool) -> bool:
+def _build_into(folder: Path, files: Mapping[str, str], opt: str, peer: bool, tables: str) -> bool:
     src, obj = folder / "src", folder / "obj"
     src.mkdir(parents=True)
     obj.mkdir()
+    (folder / "link.ld").write_text(linker_script(tables))
     for fname, text in files.items():
         (src / fname).write_text(text, encoding="utf-8")
     objects = _compile(src, obj, opt, peer)
@@ -197,17 +211,18 @@ def _intact(folder: Path) -> bool:
         return False
 
 
-def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool = False) -> ArmBuild:
+def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool = False,
+          tables: str = "ccm") -> ArmBuild:
     """Build (or fetch from the cache) the ELF of generated sources + an adapter's C text.
 
     peer=True is for benchmarks of third-party C only: libm and newlib are linked and
-    warnings are not errors (see cflags)."""
+    warnings are not errors (see cflags). tables: where the constant tables run (linker_script)."""
     files = dict(sources)
     files["adapter.c"] = adapter
     for fname in SUPPORT_FILES:
         files[fname] = (HERE / fname).read_text(encoding="utf-8")
     key_parts = {"layout": BUILD_LAYOUT, "flags": cflags(opt, peer), "peer": peer, "cc": compiler_version(),
-                 "ld": LINKER_SCRIPT.read_text(), "files": sorted(files.items())}
+                 "ld": linker_script(tables), "files": sorted(files.items())}
     key = hashlib.sha256(json.dumps(key_parts, sort_keys=True).encode()).hexdigest()
     folder = _cache_root() / key
     if folder.is_dir() and not _intact(folder):
@@ -216,7 +231,7 @@ def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool
         folder.parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=f".{key[:12]}.", suffix=".tmp", dir=folder.parent))
         try:
-            _build_into(tmp, files, opt, peer)
+            _build_into(tmp, files, opt, peer, tables)
             try:
                 os.rename(tmp, folder)
             except OSError:

@@ -8,6 +8,7 @@
 #include "harness.h"
 
 extern uint32_t _sidata[], _sdata[], _edata[], _sbss[], _ebss[], _estack[];
+extern uint32_t _sitables[], _stables[], _etables[];
 
 #define SCB_CPACR  (*(volatile uint32_t *)0xE000ED88u)
 #define FPU_FPDSCR (*(volatile uint32_t *)0xE000EF3Cu)
@@ -20,14 +21,22 @@ extern uint32_t _sidata[], _sdata[], _edata[], _sbss[], _ebss[], _estack[];
 void Reset_Handler(void);
 void Default_Handler(void);
 
-/* .data and .bss are initialised word by word through volatile pointers so that GCC cannot
- * turn the loops into memcpy/memset calls (we link without the C library). */
+/* .data, the constant tables and .bss are initialised word by word through volatile pointers so
+ * that GCC cannot turn the loops into memcpy/memset calls (we link without the C library). The
+ * tables are copied only when the linker script placed them in RAM (load address != address). */
 static void init_memory(void)
 {
     volatile uint32_t *src = _sidata;
     volatile uint32_t *dst = _sdata;
     while (dst < _edata) {
         *dst++ = *src++;
+    }
+    src = _sitables;
+    dst = _stables;
+    if (src != dst) {
+        while (dst < _etables) {
+            *dst++ = *src++;
+        }
     }
     for (dst = _sbss; dst < _ebss; ) {
         *dst++ = 0u;

@@ -136,10 +136,11 @@ def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=prin
                              **{t: {"mismatches": gate.mismatches[t]} for t in TARGETS}}},
         "selftest_vectors": {"n": vec.n, "classes": vec.classes, "targets": selftest},
         "cycles": {"step": rep["cycles"], "reference": {m: rep["by_class"]["reference"][m]["max"] for m in MODES},
-                   "per_class": plan.cycles_per_class,
-                   "functions": functions},
+                   "per_class": plan.cycles_per_class, "table": rep["table"], "bound": rep["bound"],
+                   "step_lenient": rep["cycles_lenient"], "functions": functions},
         "memory": {"flash_bytes": rep["flash_bytes"], "ram_bytes": rep["ram_bytes"],
-                   "state_bytes": rep["state_bytes"], "stack_bytes": rep["stack_bytes"]},
+                   "state_bytes": rep["state_bytes"], "stack_bytes": rep["stack_bytes"],
+                   "tables_in": unit.tables_in},
         "budgets": rep["budgets"],
     }
 

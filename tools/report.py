@@ -80,7 +80,8 @@ def verdict(value, budget, unit: str) -> str:
         return "unknown"
     if value <= budget:
         return f"within budget ({value} <= {budget} {unit})"
-    return f"OVER budget by {value - budget} {unit} ({100.0 * (value - budget) / budget:.0f} %)"
+    share = f" ({100.0 * (value - budget) / budget:.0f} %)" if budget > 0 else ""
+    return f"OVER budget by {value - budget} {unit}{share}"
 
 
 def cycle_text(rep: dict) -> list[str]:

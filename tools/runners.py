@@ -213,7 +213,8 @@ def arm_build(unit: Unit, adapter: str = "records", opt: str = "-O2") -> arm.Arm
     the `sequence` adapter (state kept in the firmware between records)."""
     if adapter == "sequence" and not unit.stateful:
         adapter = "records"   # a stateless unit's sequence is its records
-    return arm.build(unit.sources(), arm.render_adapter(adapter, **adapter_params(unit)), opt)
+    return arm.build(unit.sources(), arm.render_adapter(adapter, **adapter_params(unit)), opt,
+                     tables=unit.tables_in)
 
 
 class ArmRunner:

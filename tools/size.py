@@ -15,8 +15,8 @@ from firmware.arm import ARM_SIZE, tool
 from tools.errors import ToolError
 from tools.m4.machine import CCM, FLASH, SRAM
 
-_FLASH_SECTIONS = (".isr_vector", ".text", ".ARM.exidx", ".data")
-_RAM_SECTIONS = (".data", ".bss")
+_FLASH_SECTIONS = (".isr_vector", ".text", ".tables", ".ARM.exidx", ".data")
+_RAM_SECTIONS = (".data", ".bss")   # plus .tables when it runs from CCM
 _RESERVED = (".harness_arena",)
 _MAP_ROW = re.compile(r"^\s(\.\S+)?\s+0x([0-9a-fA-F]+)\s+0x([0-9a-fA-F]+)\s+(\S+)$")
 
@@ -35,7 +35,8 @@ class Sizes:
 
 
 def section_sizes(elf: Path) -> dict[str, int]:
-    """arm-none-eabi-size -A: {section: bytes}."""
+    """arm-none-eabi-size -A: {section: bytes}; ".tables@ram" also holds .tables' size when it
+    runs from RAM (CCM)."""
     res = subprocess.run([tool(ARM_SIZE), "-A", str(elf)], capture_output=True, text=True, check=False)
     if res.returncode != 0:
         raise ToolError(f"arm-none-eabi-size failed on {elf}: {res.stderr.strip().splitlines()[:1]}")
@@ -44,6 +45,8 @@ def section_sizes(elf: Path) -> dict[str, int]:
         parts = line.split()
         if len(parts) == 3 and parts[0].startswith(".") and parts[1].isdigit():
             out[parts[0]] = int(parts[1])
+            if parts[0] == ".tables" and not _in(int(parts[2]), FLASH):
+                out[".tables@ram"] = int(parts[1])
     return out
 
 
@@ -80,15 +83,15 @@ def map_objects(map_file: Path) -> dict[str, dict[str, int]]:
             row["flash"] += size
         elif _in(addr, SRAM) or _in(addr, CCM):
             row["ram"] += size
-            if name.startswith(".data"):
-                row["flash"] += size  # its initial values are stored in flash
+            if name.startswith((".data", ".rodata")):
+                row["flash"] += size  # its initial values are stored in flash (copied at start-up)
     return out
 
 
 def sizes(elf: Path, map_file: Path | None = None) -> Sizes:
     sec = section_sizes(elf)
     flash = sum(sec.get(s, 0) for s in _FLASH_SECTIONS)
-    ram = sum(sec.get(s, 0) for s in _RAM_SECTIONS)
+    ram = sum(sec.get(s, 0) for s in _RAM_SECTIONS) + sec.get(".tables@ram", 0)
     reserved = sum(sec.get(s, 0) for s in _RESERVED)
     per_object = map_objects(map_file) if map_file is not None else {}
     return Sizes(sec, flash, ram, reserved, per_object)

@@ -23,8 +23,9 @@ class Function:
 
 @dataclass(frozen=True)
 class Segment:
-    addr: int    # load (physical) address: .data's image sits in flash, startup copies it
+    addr: int    # load (physical) address: .data's and the tables' images sit in flash, startup copies them
     data: bytes
+    vaddr: int = -1  # run address (differs from addr for what startup copies to RAM)
 
 
 class Image:
@@ -37,7 +38,7 @@ class Image:
                 elf = ELFFile(fh)
                 if elf["e_machine"] != EM_ARM:
                     raise ToolError(f"{self.path}: not an ARM ELF (machine {elf['e_machine']})")
-                self.segments = [Segment(s["p_paddr"], s.data()) for s in elf.iter_segments()
+                self.segments = [Segment(s["p_paddr"], s.data(), s["p_vaddr"]) for s in elf.iter_segments()
                                  if s["p_type"] == "PT_LOAD" and s["p_filesz"] > 0]
                 self.symbols, funcs, self.objects = _read_symbols(elf)
                 self.mapping = _read_mapping_symbols(elf)
@@ -74,11 +75,14 @@ class Image:
         return -1
 
     def read(self, addr: int, size: int) -> bytes:
-        """Bytes of the loaded image at addr (code and constants live in flash)."""
-        for seg in self.segments:
-            if seg.addr <= addr and addr + size <= seg.addr + len(seg.data):
-                off = addr - seg.addr
-                return seg.data[off:off + size]
+        """Bytes of the loaded image at addr: a load address (flash), else a run address whose
+        initial value the image holds (a constant startup copies to RAM, e.g. adapter_in_bytes)."""
+        for base in ("addr", "vaddr"):
+            for seg in self.segments:
+                a = getattr(seg, base)
+                if a <= addr and addr + size <= a + len(seg.data):
+                    off = addr - a
+                    return seg.data[off:off + size]
         raise ToolError(f"{self.path.name}: address 0x{addr:08x} is not in a loaded segment")
 
     def code_ranges(self, start: int, size: int) -> list[tuple[int, int]]:

@@ -96,7 +96,9 @@ class LineTable:
                     st = entry.state
                     if st is not None and not st.end_sequence:
                         rows.append((st.address, names.get(st.file, "?"), st.line))
-        self.rows = sorted(rows)
+        # By address only, stably: where one address has several rows, the programme's last one
+        # (the instruction's own line) is the one bisect finds.
+        self.rows = sorted(rows, key=lambda r: r[0])
         self._addrs = [r[0] for r in self.rows]
 
     def line_of(self, addr: int) -> tuple[str, int] | None:

@@ -89,8 +89,9 @@ def test_cycle_report_of_tanh_step():
     assert rep["cycles_lenient"]["ideal"]["max"] <= 1_500 and unit.budgets.cycles == 1_200
     assert rep["cycles"]["ideal"]["max"] <= rep["bound"]["strict"]["ideal"]
     assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
-    # 13,664 B measured, of which 2 x 1,544 B the two sg_powc_t tables
-    assert 0 < rep["flash_bytes"] <= 14 * 1024 and rep["ram_bytes"] == 0 and not rep["newlib"]
+    # 13,664 B measured, of which 2 x 1,544 B the two sg_powc_t tables; the constant tables run
+    # from CCM (copied at start-up), so they count in RAM too, the two sg_powc_t tables at least
+    assert 0 < rep["flash_bytes"] <= 14 * 1024 and 2 * 1_544 <= rep["ram_bytes"] <= 8 * 1024 and not rep["newlib"]
     # the law's nine tanh, six powers and one log are inline in tanh_step (sg_inline_tanhf_full,
     # sg_powf_const, sg_logf_tab); sg_tanhf is the 180 deg fallback's six
     assert {"sg_tanhf", "tanh_step"} <= set(rep["functions"])

@@ -19,7 +19,7 @@ class SatlinUnit(Unit):
 
     def __init__(self, name: str = "satlin"):
         super().__init__(check_name(name), np.dtype([("x", "<f4", (3,))]), np.dtype([("u", "<f4", (3,))]), None,
-                         Budgets(cycles=200, flash=1024, ram=0, stack=64))
+                         Budgets(cycles=200, flash=1024, ram=64, stack=64))
 
     def sources(self) -> dict[str, str]:
         env = environment(TEMPLATES)
