@@ -412,7 +412,7 @@ class Analysis:
         cycles = {}
         for table in TABLES:
             ideal = self._ipet(name, blocks, loops, start, lambda b, t=table: b.cost[t],
-                               lambda c, t=table: c[t], lambda callee, t=table: sub[callee].cycles[(t, "ideal")])
+                               lambda _b, _d, c, t=table: c[t], lambda b, t=table: sub[b.call].cycles[(t, "ideal")])
             base = ideal + (entry_s if table == "strict" else 0)
             cycles[(table, "ideal")] = base
             cycles[(table, "art")] = base + sum(parts.values())
@@ -422,9 +422,9 @@ class Analysis:
         edges = [(None, start, 0.0)]  # the entry edge
         for b in blocks.values():
             for d, c, kind in b.succ:
-                w = float(edge_cost(c))
+                w = float(edge_cost(b, d, c))
                 if b.call is not None:
-                    w += call_cost(b.call)
+                    w += call_cost(b)
                 if d is not None:
                     w += block_cost(blocks[d])
                 edges.append((b.addr, d, w))
@@ -472,10 +472,48 @@ class Analysis:
             if fits is not False:
                 out[part] = int(fits)
                 continue
-            # No reuse can be proved: every block execution pays for each of its lines or reads;
-            # a callee costs its own bound of the same part.
-            out[part] = self._ipet(name, blocks, loops, start, lambda b, f=per_block: WAIT_STATES * f(b),
-                                   lambda c: 0, lambda callee, p=part: sub[callee].art_parts[p])
+            out[part] = self._scoped(name, blocks, loops, start, sub, part, per_block)
+        return out
+
+    def _scoped(self, name, blocks, loops, start, sub, part, per_block) -> int:
+        """The function does not fit the cache as a whole: each outermost loop whose code (or
+        literal lines) with its callees fits misses each of its lines at most once per entry
+        (charged on its entry edges); every other block execution pays for each of its lines or
+        reads, and a call from outside such a loop costs the callee's own bound of the part."""
+        capacity = {"code": ART_I_LINES, "literal": ART_D_LINES}.get(part, 0)
+        scopes: dict[int, tuple[set[int], int]] = {}
+        for h, body, _k, _w in sorted(loops, key=lambda lp: -len(lp[1])):
+            if capacity and not any(body <= b for b, _n in scopes.values()):
+                lines = self._lines_of(blocks, body, part)
+                if len(lines) <= capacity:
+                    scopes[h] = (body, len(lines))
+        covered = set().union(*(b for b, _n in scopes.values())) if scopes else set()
+
+        def block_cost(b: _Block) -> int:
+            return 0 if b.addr in covered else WAIT_STATES * per_block(b)
+
+        def edge_cost(b: _Block, d, _c) -> int:
+            if d in scopes and b.addr not in scopes[d][0]:
+                return WAIT_STATES * scopes[d][1]
+            return 0
+
+        def call_cost(b: _Block) -> int:
+            return 0 if b.addr in covered else sub[b.call].art_parts[part]
+
+        return self._ipet(name, blocks, loops, start, block_cost, edge_cost, call_cost)
+
+    def _lines_of(self, blocks, body: set[int], part: str) -> set[int]:
+        """Code lines (part "code") or literal lines of the blocks `body` and what they call."""
+        out: set[int] = set()
+        for a in body:
+            b = blocks[a]
+            if part == "code":
+                out |= {x >> LINE_SHIFT for i in b.insns for x in range(i.addr, i.addr + i.size, 2)}
+            else:
+                out |= {_literal_address(i) >> LINE_SHIFT for i in b.insns if _reads(i) and "pc" in i.cost.addr_regs}
+            if b.call:
+                code, lits = self._footprint(b.call)
+                out |= code if part == "code" else lits
         return out
 
     def _footprint(self, name: str, seen: set[str] | None = None) -> tuple[set[int], set[int]]:
