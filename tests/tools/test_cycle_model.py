@@ -5,7 +5,13 @@ derived by hand from the TRM in the comment beside it (line by line, "lenient | 
 model must reproduce each exactly in `ideal` mode.
 """
 import capstone
+import numpy as np
 import pytest
+
+from codegen.units import kinds
+from tests.codegen.units import unit_checks as checks
+from tools.m4.harness import Harness
+from tools.runners import arm_build, pack
 
 from firmware.arm import BENCH, bench_build
 from tools import stack
@@ -150,3 +156,24 @@ def test_breakpoint_stops_with_error(bench):
     m.write(SCRATCH, bytes.fromhex("00be"))  # bkpt #0, as in Default_Handler
     with pytest.raises(ToolError, match="exception"):
         m.call(SCRATCH)
+
+
+# --------------------------------------------------------------- profiling does not change execution
+
+@pytest.mark.parametrize("kind", ["network", "controller", "tanh"])
+def test_profiling_leaves_the_execution_unchanged(kind):
+    """The profiler's hooks must not alter what the emulator computes: a code or memory hook on an
+    instruction inside an IT block corrupts Unicorn's IT state (later instructions skipped; found
+    here on the controller's random-bit records). Outputs with and without the profiler, bit for
+    bit, over the unit's cycle classes and random bits."""
+    unit = checks.example_unit(kinds()[kind])
+    image = Image(arm_build(unit).elf)
+    parts = [pack(unit, b).view(np.uint8).reshape(b.input.shape[0], -1) for b in unit.cycle_classes(40, 3).values()]
+    parts.append(np.random.default_rng(5).integers(0, 256, (300, image.word("adapter_in_bytes")), dtype=np.uint8))
+    records = np.vstack(parts)
+    prof = Profiler(image, unit.step_symbol)
+    profiled = Harness(image, machine=prof.machine)
+    profiled.reset(runner=prof.run)
+    got = profiled.run(records, runner=prof.run)
+    assert np.array_equal(got, Harness(image).run(records))
+    assert len(prof.evaluations) == records.shape[0]

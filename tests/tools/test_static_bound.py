@@ -10,6 +10,7 @@ from tools.cycles import bench_expectations, profile_entry, run_bench
 from tools.errors import ToolError
 from tools.m4.elf import Image
 from tools.m4.wcet import Analysis
+from tools.report import cycle_report
 from tools.runners import arm_build
 
 EXPECT = bench_expectations(BENCH)
@@ -90,3 +91,15 @@ def test_bound_covers_every_sampled_count_on_random_bits(kind):
     for table, sampled in (("strict", prof.cycles), ("lenient", prof.cycles_lenient)):
         for mode in ("ideal", "art"):
             assert sampled[mode]["max"] <= fb.cycles[(table, mode)], (table, mode)
+
+
+# ----------------------------------------------------------------- tightness (SPEC 8 uses both)
+
+@pytest.mark.parametrize("kind", ["network", "controller"])
+def test_bound_is_within_15_percent_of_the_sampled_max(kind):
+    """The network path and the whole step: the static bound is at most 15 % above the largest
+    count over the unit's own cycle classes (ideal, strict), so the bound is a figure to sign,
+    not a loose ceiling."""
+    unit = checks.example_unit(kinds()[kind])
+    rep = cycle_report(unit, ("ideal",), per_class=100, seed=0)
+    assert rep["bound"]["strict"]["ideal"] <= 1.15 * rep["cycles"]["ideal"]["max"], rep["bound"]

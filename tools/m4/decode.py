@@ -1,6 +1,7 @@
 """Capstone decoding cached per address, and basic blocks with a precomputed static cost."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 import capstone
@@ -42,6 +43,7 @@ class Block:
     head: tuple           # (Cost, inside an IT block) of the first instruction
     tail: tuple           # (Cost, inside an IT block) of the last instruction
     entry_s: int          # strict cycles added when a taken branch lands here
+    lits: tuple = ()      # flash lines of the literal-pool words its unconditional loads read, in order
 
 
 class Decoder:
@@ -54,7 +56,8 @@ class Decoder:
         self.cs = capstone.Cs(capstone.CS_ARCH_ARM, capstone.CS_MODE_THUMB | capstone.CS_MODE_MCLASS)
         self.cs.detail = True
         self._insns: dict[int, Insn] = {}
-        self.it_scanned: dict[int, int] = {}  # filled by scan_it before the first run
+        self.it_scanned: dict[int, tuple[int, int]] = {}  # filled by scan_it before the first run
+        self.it_blocks: dict[int, list] = {}
 
     def insn(self, addr: int) -> Insn:
         hit = self._insns.get(addr)
@@ -113,7 +116,7 @@ class Decoder:
 
     def summarise(self, addr: int, size: int, insns: list[Insn]) -> Block:
         cost_s = cost_l = 0
-        it_left, prev, prev_it, head = 0, None, False, None
+        it_left, prev, prev_it, head, lits = 0, None, False, None, []
         for ins in insns:
             c = ins.cost
             # Inside an IT block opened in this block, or (a block split by Unicorn) one
@@ -128,6 +131,7 @@ class Decoder:
                 cost_s += c.strict
                 cost_l += c.cycles
                 it_left = c.it_count
+                lits += literal_lines(ins)
             if prev is not None:
                 ds, dl = pair(prev, c, prev_it, in_it)
                 cost_s += ds
@@ -142,19 +146,84 @@ class Decoder:
             lines = tuple(range(addr >> LINE_SHIFT, ((addr + size - 1) >> LINE_SHIFT) + 1))
         return Block(addr, size, len(insns), cost_s, cost_l, addr + size, last.flow, cond_pen,
                      self.image.function_index(addr), lines, head, (last, prev_it),
-                     entry_extra(insns[0].cost, addr))
+                     entry_extra(insns[0].cost, addr), tuple(lits))
 
     def scan_it(self, start: int, size: int) -> dict[int, tuple[int, int]]:
         """IT-conditional instructions of a code range: {addr: (strict, lenient) extra cycles
         when executed} (executed cost - 1, the skipped cost; an executed branch in an IT block
-        is taken)."""
-        out, it_left = {}, 0
+        is taken). Also records each IT block in `it_blocks`: {IT address: [(member address,
+        condition, (strict, lenient) extra, whether an earlier member may change the flags,
+        whether it may, the literal lines it reads)]}."""
+        out, members, it_at, cond_pattern = {}, 0, None, ""
         for ins in self.linear(start, size):
             c = ins.cost
-            if it_left:
-                it_left -= 1
-                out[ins.addr] = (c.strict + c.taken_extra - 1, c.cycles + c.taken_extra - 1)
+            if members:
+                k = len(self.it_blocks[it_at])
+                cond = cond_pattern[0] if cond_pattern[k] == "t" else _INVERSE[cond_pattern[0]]
+                extra = (c.strict + c.taken_extra - 1, c.cycles + c.taken_extra - 1)
+                flags_changed = any(m[4] for m in self.it_blocks[it_at])
+                self.it_blocks[it_at].append((ins.addr, cond, extra, flags_changed, _sets_apsr(ins.text),
+                                              literal_lines(ins)))
+                out[ins.addr] = extra
+                members -= 1
                 continue
-            it_left = c.it_count
+            if c.it_count:
+                mnem, _, cond = ins.text.partition(" ")
+                members, it_at = c.it_count, ins.addr
+                cond_pattern = [cond.strip()] + list(mnem[2:])  # condition, then "t"/"e" per member
+                cond_pattern = [cond_pattern[0], "t", *cond_pattern[1:]]
+                self.it_blocks[it_at] = []
         self.it_scanned.update(out)
         return out
+
+
+# Condition codes, their inverses, and whether NZCV (bits 31..28) satisfies each.
+_INVERSE = {"eq": "ne", "ne": "eq", "cs": "cc", "hs": "lo", "cc": "cs", "lo": "hs", "mi": "pl", "pl": "mi",
+            "vs": "vc", "vc": "vs", "hi": "ls", "ls": "hi", "ge": "lt", "lt": "ge", "gt": "le", "le": "gt",
+            "al": "al"}
+
+
+def condition_holds(cond: str, psr: int) -> bool:
+    n, z, c, v = (psr >> 31) & 1, (psr >> 30) & 1, (psr >> 29) & 1, (psr >> 28) & 1
+    return {"eq": z == 1, "ne": z == 0, "cs": c == 1, "hs": c == 1, "cc": c == 0, "lo": c == 0,
+            "mi": n == 1, "pl": n == 0, "vs": v == 1, "vc": v == 0, "hi": c == 1 and z == 0,
+            "ls": c == 0 or z == 1, "ge": n == v, "lt": n != v, "gt": z == 0 and n == v,
+            "le": z == 1 or n != v, "al": True}[cond]
+
+
+def _sets_apsr(text: str) -> bool:
+    """Whether an instruction may write the condition flags (then later IT members' conditions
+    are not known at the IT instruction)."""
+    mnem = text.split()[0]
+    return (mnem.startswith(("cmp", "cmn", "tst", "teq", "msr")) or text.startswith("vmrs apsr_nzcv")
+            or (len(mnem) > 1 and mnem.split(".")[0].endswith("s") and not mnem.startswith(("vmrs", "vabs", "vmls",
+                                                                                               "vnmls", "vfms", "vfnms"))))
+
+
+_LOADS = re.compile(r"^(ldr|ldm|pop|vldr|vldm|vpop|tbb|tbh)")
+
+
+def words_read(ins: Insn) -> int:
+    """Words an instruction reads from memory (0 for everything but loads)."""
+    mnem = ins.text.split()[0]
+    if not _LOADS.match(mnem):
+        return 0
+    if mnem.startswith(("ldm", "pop", "vldm", "vpop")):
+        return ins.cost.cycles - 1 - (2 if "pc" in ins.text and mnem.startswith(("ldm", "pop")) else 0)
+    return 2 if mnem.startswith("ldrd") or re.match(r"vldr\S* d", ins.text) else 1
+
+
+def literal_address(ins: Insn) -> int:
+    """Address a PC-relative load reads (Align(PC, 4) + imm)."""
+    m = re.search(r"\[pc, #(-?0x[0-9a-f]+|-?\d+)\]", ins.text)
+    if not m:
+        raise ToolError(f"cannot read the literal address of 0x{ins.addr:08x} ({ins.text})")
+    return ((ins.addr + 4) & ~3) + int(m.group(1), 0)
+
+
+def literal_lines(ins: Insn) -> tuple:
+    """128-bit flash lines a PC-relative load reads, one per word, in order (empty otherwise)."""
+    if "pc" not in ins.cost.addr_regs or not re.search(r"\[pc, #", ins.text) or not words_read(ins):
+        return ()
+    a = literal_address(ins)
+    return tuple((a + 4 * k) >> LINE_SHIFT for k in range(words_read(ins)))

@@ -74,6 +74,12 @@ class Image:
             return i
         return -1
 
+    def flash_objects(self, flash: tuple[int, int]) -> list[Function]:
+        """Data objects the image keeps in flash (tables left there), the vector table aside."""
+        lo, hi = flash[0], flash[0] + flash[1]
+        vec = self.sections.get(".isr_vector", (0, 0, 0, 0))
+        return [o for o in self.objects if lo <= o.start < hi and not vec[0] <= o.start < vec[0] + vec[1]]
+
     def read(self, addr: int, size: int) -> bytes:
         """Bytes of the loaded image at addr: a load address (flash), else a run address whose
         initial value the image holds (a constant startup copies to RAM, e.g. adapter_in_bytes)."""

@@ -5,8 +5,9 @@ a conditional branch that was taken (known from this block's address) and, stric
 branch's target-alignment cycle; on a fall-through, the pair rules between the previous block's
 last instruction and this block's first (pipelining, strict stalls); plus the flash stalls of
 each memory model. IT-conditional instructions are charged 1 statically (their skipped cost); a
-code hook on each costlier one adds the rest when it executes (Unicorn fires no hook for skipped
-ones). Both timing tables and all three memory modes are costed in the same run: the
+code hook on the IT instruction reads the flags and adds the rest for the members that execute
+(no hook inside an IT block: it corrupts Unicorn's IT state). Literal-pool reads are known per
+block; a memory hook watches only tables left in flash. Both timing tables and all three memory modes are costed in the same run: the
 accumulators are strict ideal, strict art, strict pessimistic, lenient ideal (the memory stalls
 are the same events under both tables, so lenient art = lenient ideal + art stalls).
 
@@ -21,11 +22,11 @@ from dataclasses import dataclass, field
 from unicorn import UC_HOOK_BLOCK, UC_HOOK_CODE, UC_HOOK_MEM_READ
 from unicorn import arm_const as R
 
-from tools.m4.decode import LINE_SHIFT, Decoder
+from tools.m4.decode import LINE_SHIFT, Decoder, condition_holds
 from tools.m4.elf import Image
 from tools.m4.machine import FLASH, Machine
 from tools.m4.memory import ArtModel, PessimisticModel
-from tools.m4.timing import FLOW_CALL, FLOW_COND, pair
+from tools.m4.timing import FLOW_CALL, FLOW_JUMP, pair
 
 MODES = ("ideal", "art", "pessimistic")
 _NOBLOCK_FALL = -1
@@ -52,11 +53,19 @@ class _Prev:
     cond_pen = 0
     fid = -1
     addr = -1
+    tail = (None, False)
 
 
 def lenient_modes(total) -> tuple[int, int, int]:
     """(ideal, art, pessimistic) under the lenient table from an accumulator 4-tuple."""
     return total[3], total[3] + total[1] - total[0], total[3] + total[2] - total[0]
+
+
+_ALIASES = {"sb": "r9", "sl": "r10", "fp": "r11", "ip": "r12"}
+
+
+def _core_reg(uc, name: str) -> int:
+    return uc.reg_read(R.UC_ARM_REG_R0 + int(_ALIASES.get(name, name)[1:]))
 
 
 class Profiler:
@@ -81,11 +90,25 @@ class Profiler:
         for f in self.image.functions:
             if f.start < FLASH[0] or f.start >= FLASH[0] + FLASH[1] or f.size == 0:
                 continue
-            for addr, extra in self.dec.scan_it(f.start, f.size).items():
-                if max(extra) > 0:
-                    uc.hook_add(UC_HOOK_CODE, self._on_it_executed, extra, addr, addr)
+            self.dec.scan_it(f.start, f.size)
+        # The executed IT members are found at the IT instruction itself, from the flags: a code
+        # hook on an instruction inside an IT block corrupts Unicorn's IT state (unicorn-engine
+        # issue 2309: later instructions are skipped; measured here as outputs that differ from
+        # an unhooked run).
+        for it_addr, members in self.dec.it_blocks.items():
+            if any(max(m[2]) > 0 or m[5] for m in members):
+                uc.hook_add(UC_HOOK_CODE, self._on_it, members, it_addr, it_addr)
         if self.memory_modes:
-            uc.hook_add(UC_HOOK_MEM_READ, self._on_flash_read, None, FLASH[0], FLASH[0] + FLASH[1] - 1)
+            # Literal-pool reads are known per block (Block.lits); only tables left in flash need
+            # a memory hook (a hook on reads inside an IT block would corrupt it, see _on_it).
+            for o in self.image.flash_objects(FLASH):
+                uc.hook_add(UC_HOOK_MEM_READ, self._on_flash_read, None, o.start, o.start + o.size - 1)
+            # TBB/TBH read their table from the code: the index register gives the line.
+            for f in self.image.functions:
+                if FLASH[0] <= f.start < FLASH[0] + FLASH[1] and f.size:
+                    for ins in self.dec.linear(f.start, f.size):
+                        if ins.text.startswith(("tbb", "tbh")):
+                            uc.hook_add(UC_HOOK_CODE, self._on_table_branch, ins, ins.addr, ins.addr)
 
     def _reset_run(self) -> None:
         self.c0 = self.c1 = self.c2 = self.c3 = 0
@@ -107,7 +130,9 @@ class Profiler:
             b = self.blocks[addr] = self.dec.block(addr, size)
         p = self.prev
         cost, cost_l = b.cost, b.cost_l
-        if addr != p.fall or p.flow >= FLOW_CALL and p.flow != FLOW_COND:  # taken (even to the next address)
+        # Taken: a new address, or an unconditional transfer to the next one (an IT-conditional
+        # call or jump that lands on the next address was skipped).
+        if addr != p.fall or (p.flow == FLOW_CALL or p.flow == FLOW_JUMP) and not p.tail[1]:
             if p.cond_pen:
                 self._charge(p.fid, p.cond_pen, p.cond_pen)
             cost += b.entry_s
@@ -123,6 +148,9 @@ class Profiler:
         if self.memory_modes and b.lines:
             c1 += self.art.fetch(b.lines)
             c2 += self.pess.fetch(b.lines)
+            for ln in b.lits:
+                c1 += self.art.data(ln)
+                c2 += self.pess.data(ln)
         self.c0 += cost
         self.c1 += c1
         self.c2 += c2
@@ -147,11 +175,28 @@ class Profiler:
         e[2] += ds
         e[3] += dl
 
-    def _on_it_executed(self, uc, addr, size, extra):
-        self._charge(self.prev.fid, extra[0], extra[1])
+    def _on_it(self, uc, addr, size, members):
+        """An IT instruction: charge the executed members' extra cycles. A member after one that
+        may change the flags is charged as executed (its condition is not known here)."""
+        psr = uc.reg_read(R.UC_ARM_REG_XPSR)
+        for _addr, cond, extra, flags_changed, _sets, lits in members:
+            if flags_changed or condition_holds(cond, psr):
+                self._charge(self.prev.fid, extra[0], extra[1])
+                if self.memory_modes:
+                    for ln in lits:
+                        self._flash_line(ln)
+
+    def _on_table_branch(self, uc, addr, size, ins):
+        """TBB [Rn, Rm] / TBH [Rn, Rm, lsl #1]: charge the line of the table entry it reads."""
+        base, _, index = ins.text.partition("[")[2].rstrip("]").partition(", ")
+        rn = addr + 4 if base == "pc" else _core_reg(uc, base)
+        offset = _core_reg(uc, index.split(",")[0].strip()) * (2 if ins.text.startswith("tbh") else 1)
+        self._flash_line((rn + offset) >> LINE_SHIFT)
 
     def _on_flash_read(self, uc, access, addr, size, value, _data):
-        line = addr >> LINE_SHIFT
+        self._flash_line(addr >> LINE_SHIFT)
+
+    def _flash_line(self, line: int) -> None:
         d1, d2 = self.art.data(line), self.pess.data(line)
         self.c1 += d1
         self.c2 += d2

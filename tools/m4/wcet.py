@@ -37,7 +37,7 @@ from elftools.elf.elffile import ELFFile
 from scipy.optimize import Bounds, LinearConstraint, milp
 
 from tools.errors import ToolError
-from tools.m4.decode import LINE_SHIFT, Decoder, Insn
+from tools.m4.decode import LINE_SHIFT, Decoder, Insn, literal_address, words_read
 from tools.m4.elf import Image
 from tools.m4.machine import FLASH
 from tools.m4.memory import ART_D_LINES, ART_I_LINES, WAIT_STATES
@@ -154,7 +154,7 @@ class Analysis:
         self.sources = Path(sources)
         self.marks = loop_annotations(self.sources)
         self._extents: dict[tuple[str, str], set[int] | None] = {}
-        self.flash_tables = flash_data_objects(image)
+        self.flash_tables = sorted(o.name for o in image.flash_objects(FLASH))
         self.literals_only = (not self.flash_tables if flash_data_is_literals_only is None
                               else flash_data_is_literals_only)
         self.starts = {f.start: f.name for f in image.functions}
@@ -510,7 +510,7 @@ class Analysis:
             if part == "code":
                 out |= {x >> LINE_SHIFT for i in b.insns for x in range(i.addr, i.addr + i.size, 2)}
             else:
-                out |= {_literal_address(i) >> LINE_SHIFT for i in b.insns if _reads(i) and "pc" in i.cost.addr_regs}
+                out |= {literal_address(i) >> LINE_SHIFT for i in b.insns if words_read(i) and "pc" in i.cost.addr_regs}
             if b.call:
                 code, lits = self._footprint(b.call)
                 out |= code if part == "code" else lits
@@ -524,8 +524,8 @@ class Analysis:
         for b in self.graph(name).values():
             for i in b.insns:
                 code |= {a >> LINE_SHIFT for a in range(i.addr, i.addr + i.size, 2)}
-                if _reads(i) and "pc" in i.cost.addr_regs:
-                    lits.add(_literal_address(i) >> LINE_SHIFT)
+                if words_read(i) and "pc" in i.cost.addr_regs:
+                    lits.add(literal_address(i) >> LINE_SHIFT)
             if b.call and b.call not in seen:
                 c, lt = self._footprint(b.call, seen)
                 code |= c
@@ -533,46 +533,17 @@ class Analysis:
         return code, lits
 
 
-_LOADS = re.compile(r"^(ldr|ldm|pop|vldr|vldm|vpop|tbb|tbh)")
-
-
-def _reads(ins: Insn) -> int:
-    """Words an instruction reads from memory (0 for everything but loads)."""
-    mnem = ins.text.split()[0]
-    if not _LOADS.match(mnem):
-        return 0
-    if mnem.startswith(("ldm", "pop", "vldm", "vpop")):
-        return ins.cost.cycles - 1 - (2 if "pc" in ins.text and mnem.startswith(("ldm", "pop")) else 0)
-    return 2 if mnem.startswith("ldrd") or re.match(r"vldr\S* d", ins.text) else 1
-
-
 def _code_lines(b: _Block) -> int:
     return len({a >> LINE_SHIFT for i in b.insns for a in range(i.addr, i.addr + i.size, 2)})
 
 
 def _literal_reads(b: _Block) -> int:
-    return sum(_reads(i) for i in b.insns if "pc" in i.cost.addr_regs)
+    return sum(words_read(i) for i in b.insns if "pc" in i.cost.addr_regs)
 
 
 def _other_reads(b: _Block) -> int:
     """Reads whose address is neither PC- nor SP-relative: flash unless proved otherwise."""
-    return sum(_reads(i) for i in b.insns if not {"pc", "sp"} & i.cost.addr_regs)
-
-
-def _literal_address(ins: Insn) -> int:
-    """Address a PC-relative load reads (Align(PC, 4) + imm)."""
-    m = re.search(r"\[pc, #(-?0x[0-9a-f]+|-?\d+)\]", ins.text)
-    if not m:
-        raise ToolError(f"cannot read the literal address of 0x{ins.addr:08x} ({ins.text})")
-    return ((ins.addr + 4) & ~3) + int(m.group(1), 0)
-
-
-def flash_data_objects(image: Image) -> list[str]:
-    """Data objects the image keeps in flash (read-only tables), the vector table aside."""
-    lo, hi = FLASH[0], FLASH[0] + FLASH[1]
-    vectors = image.sections.get(".isr_vector", (0, 0, 0, 0))
-    return sorted(o.name for o in image.objects
-                  if lo <= o.start < hi and not vectors[0] <= o.start < vectors[0] + vectors[1])
+    return sum(words_read(i) for i in b.insns if not {"pc", "sp"} & i.cost.addr_regs)
 
 
 def _dominators(blocks: dict[int, _Block], start: int) -> dict[int, set[int]]:
