@@ -109,6 +109,9 @@ def sqrt_gt_threshold(n1: np.float32) -> np.float32:
 
 def template_context(p: TanhParams, period: float, name: str) -> dict:
     c = constants32(p, period)
+    if not c.eta >= np.finfo(np.float32).tiny:
+        # f's power branch (|x| > eta) reads |x| as a positive normal float: no slow path there
+        raise CodegenError(f"eta = {p.eta!r} is below the smallest normal float32 (1.18e-38)")
     literal = {k: c_float(v) for k, v in c.scalars.items()}
     literal["n1_dsq"] = c_float(sqrt_gt_threshold(c.n1))
     literal["J"] = [c_float(v) for v in c.J]

@@ -5,7 +5,9 @@ states: a 3-vector is a tuple of three (N,) float32 arrays, R_e nine of them; ev
 is a mask (np.where), both sides computed, the taken one kept. Sums are written out left to
 right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin): tanhf,
 logf_tab, sqrtf, powf_const; |x|^γ = |x|·powf_const(|x|, γ−1) in f (11), powf_const(|x|, γ) in
-u_a (20), as in the C. Constants are the float32 values of codegen.tanh_emit.constants32, the
+u_a (20) (+0 where |δ_i| is not a positive normal float: the C has no slow path there), as in the
+C. The C's tanh, powers and log are its own inline copies of sg_math's table paths (the same
+operations in the same order), so detmath's functions are their twins. Constants are the float32 values of codegen.tanh_emit.constants32, the
 same ones the C carries as hex floats. Every stage asserts float32 (numpy 2 promotes float32
 with a float64 scalar).
 
@@ -63,8 +65,15 @@ def shaping(k: Constants32, x):
     return f32(f, "shaping"), f32(slope, "shaping slope")
 
 
+def positive_normal(x) -> np.ndarray:
+    """x is a positive normal float32 (the C's (bits - 0x00800000) < 0x7f000000)."""
+    return (x.view(np.uint32) - np.uint32(0x00800000)) < np.uint32(0x7F000000)
+
+
 def sig_pow(k: Constants32, d):
-    p = detmath.powf_const(np.abs(d), detmath.powc_tables(k.gamma))
+    """{name}_sig_pow: sg_powf_const's table path for |d| a positive normal float, else +0."""
+    ad = np.abs(d)
+    p = np.where(positive_normal(ad), detmath.powf_const(ad, detmath.powc_tables(k.gamma)), F32(0.0))
     return f32(np.where(d < F32(0.0), -p, p), "sig_pow")
 
 

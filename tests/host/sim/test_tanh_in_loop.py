@@ -74,9 +74,10 @@ def test_sil_and_pil_fly_the_same_trajectory(sil, pil):
 def test_pil_reports_cycles_per_step(pil):
     cycles = pil["history"]["cycles"]
     assert cycles.shape == (401,) and pil["cycles_min"] > 1000
-    # the example's own steps, strict table: measured up to 1,628 ideal (1,408 under the lenient
-    # table); SPEC 8's 1,200 is not met yet (issue 16), so this guards against regressions only
-    assert pil["cycles_max"] <= 1_700
+    # the example's own steps, strict table: measured up to 1,443 ideal (1,628 before the cycle
+    # work of docs/tanh-controller.md, "Cycles"); SPEC 8's 1,200 is not met yet (issue 16), so this
+    # guards against regressions only
+    assert pil["cycles_max"] <= 1_500
 
 
 def test_cycle_report_of_tanh_step():
@@ -85,18 +86,18 @@ def test_cycle_report_of_tanh_step():
     rep = cycle_report(unit, ("ideal",), per_class=250, seed=0)
     assert set(rep["by_class"]) == {"random", "small", "delta", "singular", "off_so3", "extreme", "special",
                                     "example"}
-    # the first table's budget as a regression guard; SPEC 8 (strict, <= 1,200) is issue 16's open item
+    # regression guards; SPEC 8 (strict, <= 1,200) is issue 16's open item. Measured: sampled 1,463,
+    # static bound 1,469 (strict; 1,409 / 1,415 lenient)
     assert rep["cycles_lenient"]["ideal"]["max"] <= 1_500 and unit.budgets.cycles == 1_200
-    assert rep["cycles"]["ideal"]["max"] <= rep["bound"]["strict"]["ideal"]
+    assert rep["cycles"]["ideal"]["max"] <= rep["bound"]["strict"]["ideal"] <= 1_500
     assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
     # 13,664 B measured, of which 2 x 1,544 B the two sg_powc_t tables; the constant tables run
     # from CCM (copied at start-up), so they count in RAM too, the two sg_powc_t tables at least
     assert 0 < rep["flash_bytes"] <= 14 * 1024 and 2 * 1_544 <= rep["ram_bytes"] <= 8 * 1024 and not rep["newlib"]
-    # the law's nine tanh, six powers and one log are inline in tanh_step (sg_inline_tanhf_full,
-    # sg_powf_const, sg_logf_tab); sg_tanhf is the 180 deg fallback's six
-    assert {"sg_tanhf", "tanh_step"} <= set(rep["functions"])
-    assert not {"sg_expf", "sg_logf", "sg_powf_pos"} & set(rep["functions"])
-    assert rep["functions"]["sg_tanhf"]["calls"]["max"] == 6
+    # every tanh, power and log of the law and of the 180 deg fallback is inline in tanh_step, and
+    # none has a slow path the law could reach: the step calls nothing (the static bound sees no
+    # sg_logf, sg_expf or sg_powf_pos either)
+    assert set(rep["functions"]) == {"tanh_step"}
     text = "\n".join(cycle_text(rep))
     # the verdict is on the larger of the static bound and the sampled maximum (SPEC 8)
     worst = max(rep["bound"]["strict"]["ideal"], rep["cycles"]["ideal"]["max"])
