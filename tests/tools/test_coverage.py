@@ -51,7 +51,10 @@ def test_cli_writes_the_report(tmp_path, capsys):
 # a unit's own files that its gate vectors leave untaken. The math library's branches are all
 # taken by its own run (tests/tools/test_coverage_library.py).
 UNREACHABLE = {
-    "controller": ("if v < -limit {", "return v == v ? v : 0.0f;", "if controller_nn_tables_crc32() !="),
+    "controller": ("b = b << 1 > 0xFF000000u ? 0u :", "if controller_nn_tables_crc32() !=",
+                   "A_bd[1] = bx1 != 0u ?", "A_bd[2] = bx2 != 0u ?",
+                   "if update_modestate, status == 0u ? 1u : 0u == 0u && may_fly != 0u {",
+                   "status |= CONTROLLER_STATUS_PID | status == 0u ? CONTROLLER_STATUS_DWELL : 0u;"),
     "network": (),
     "tanh": (),
 }

@@ -57,9 +57,76 @@ def envelope_bounds(a: Artifact, cfg: cs.ControllerConfig) -> tuple[np.ndarray, 
     return a.envelope.min, a.envelope.max
 
 
+# asin(2^-10) in degrees, rounded down: every A_bd that misses the attitude's short paths is at
+# least this large (or NaN). An envelope of A_bd inside it means the network never flies then.
+WIDE_ANGLE_DEG = 0.0559
+
+
+def wide_angles_fly(env_min: np.ndarray, env_max: np.ndarray) -> bool:
+    """Whether an A_bd off the attitude's short paths can still be inside the envelope (x[6..8])."""
+    lo, hi = np.asarray(env_min[6:9], dtype=np.float64), np.asarray(env_max[6:9], dtype=np.float64)
+    return not bool(np.all(lo > -WIDE_ANGLE_DEG) and np.all(hi < WIDE_ANGLE_DEG))
+
+
+def _key(bits: int) -> int:
+    """A float32 bit pattern as an unsigned key whose order (as int32) is the floats' order:
+    negative floats get their magnitude bits flipped (-0 just below +0, NaNs beyond +-Inf)."""
+    return (bits ^ (0x7FFFFFFF if bits >> 31 else 0)) & 0xFFFFFFFF
+
+
+def envelope_checks(env_min: np.ndarray, env_max: np.ndarray) -> list[dict]:
+    """Per network input, the integer test on its float32 bit pattern b that is true exactly when
+    !(x >= min && x <= max), NaN included (tests/codegen/units/controller checks every case):
+    'sym': min = -max > 0: (b << 1) > (bits(max) << 1); 'range': (key(b) - key_lo) > (key_hi - key_lo)
+    (unsigned) with key_lo the key of -0 when min is a zero, key_hi that of +0 when max is a zero;
+    'empty': min > max, always outside."""
+    out = []
+    for lo, hi in zip(np.asarray(env_min, dtype=np.float32), np.asarray(env_max, dtype=np.float32)):
+        blo, bhi = int(lo.view(np.uint32)), int(hi.view(np.uint32))
+        if not (np.isfinite(lo) and np.isfinite(hi)):
+            raise ValueError(f"envelope bounds must be finite, got [{lo}, {hi}]")
+        if lo > hi:
+            out.append({"kind": "empty"})
+        elif lo == -hi and hi > 0:
+            out.append({"kind": "sym", "limit": f"0x{(bhi << 1) & 0xFFFFFFFF:08x}u"})
+        else:
+            klo = _key(0x80000000) if lo == 0 else _key(blo)
+            khi = _key(0) if hi == 0 else _key(bhi)
+            out.append({"kind": "range", "key_lo": f"0x{klo:08x}u", "span": f"0x{(khi - klo) & 0xFFFFFFFF:08x}u"})
+    return out
+
+
+def envelope_outside(checks: list[dict], bits: np.ndarray) -> np.ndarray:
+    """numpy mirror of the emitted tests: (N, n_in) uint32 bit patterns -> (N, n_in) bool outside."""
+    b = np.asarray(bits, dtype=np.uint32).astype(np.uint64)
+    out = np.zeros(b.shape, dtype=bool)
+    m = np.uint64(0xFFFFFFFF)
+    key = b ^ np.where((b >> np.uint64(31)) != 0, np.uint64(0x7FFFFFFF), np.uint64(0))
+    for i, c in enumerate(checks):
+        if c["kind"] == "empty":
+            out[:, i] = True
+        elif c["kind"] == "sym":
+            out[:, i] = ((b[:, i] << np.uint64(1)) & m) > np.uint64(int(c["limit"][:-1], 16))
+        else:
+            d = (key[:, i] + np.uint64(2**32) - np.uint64(int(c["key_lo"][:-1], 16))) & m
+            out[:, i] = d > np.uint64(int(c["span"][:-1], 16))
+    return out
+
+
+def gmst_horner() -> dict:
+    """The GMST constants of the C's Horner form (A + Q) + d ((B - 4Q) + 4Q d) mod 2^64, equal to
+    A + B d + Q (2d - 1)^2 for every day; 4Q d must fit an int32 over the accepted days."""
+    q4 = 4 * cs.GMST_Q
+    if q4 * max(abs(cs.UTC_DAY_MIN), abs(cs.UTC_DAY_MAX)) >= 2**31:
+        raise ValueError("GMST: 4 Q d overflows int32 over the accepted days")
+    return {"gmst_a2": _c_u64((cs.GMST_A + cs.GMST_Q) % 2**64), "gmst_b2": _c_u64((cs.GMST_B - q4) % 2**64),
+            "gmst_q4": str(q4)}
+
+
 def controller_context(a: Artifact, cfg: cs.ControllerConfig, name: str) -> dict:
     f = c_float
     env_min, env_max = envelope_bounds(a, cfg)
+    wide_fly = wide_angles_fly(env_min, env_max)
     return {
         "name": name, "P": name.upper(), "net": net_name(name), "NET": net_name(name).upper(), "n_in": a.n_in,
         "generator_version": GENERATOR_VERSION, "sha256": a.sha256,
@@ -70,15 +137,22 @@ def controller_context(a: Artifact, cfg: cs.ControllerConfig, name: str) -> dict
         "status_bound_shift": cs.STATUS_BOUND_SHIFT,
         "utc_ms_max": cs.UTC_MS_MAX, "utc_day_min": cs.UTC_DAY_MIN, "utc_day_max": cs.UTC_DAY_MAX,
         "gmst_a": _c_u64(cs.GMST_A), "gmst_b": _c_u64(cs.GMST_B), "gmst_q": _c_u64(cs.GMST_Q),
-        "gmst_r": _c_u64(cs.GMST_R),
+        "gmst_r": _c_u64(cs.GMST_R), **gmst_horner(),
         "turn32_hi": f(TURN32_HI), "turn32_lo": f(TURN32_LO), "earth_a": f(cfg.earth_a), "earth_e2": f(cfg.earth_e2),
         "one_minus_e2": f(1.0 - cfg.earth_e2), "earth_rate": f(cfg.earth_rate), "mu": f(cfg.mu),
         "rad2deg": f(180.0 / math.pi), "minus_third": f(-1.0 / 3.0), "sixth": f(1.0 / 6.0), "torque_limit": f(cfg.torque_limit),
         "torque_limit_text": f"{cfg.torque_limit:g}",
+        "torque_limit_bits": f"0x{int(np.float32(cfg.torque_limit).view(np.uint32)):08x}",
+        "integral_limit_bits": f"0x{int(np.float32(cfg.integral_limit).view(np.uint32)):08x}",
+        "integral_limit_bits2": f"0x{(int(np.float32(cfg.integral_limit).view(np.uint32)) << 1) & 0xFFFFFFFF:08x}",
+        "torque_limit_bits2": f"0x{(int(np.float32(cfg.torque_limit).view(np.uint32)) << 1) & 0xFFFFFFFF:08x}",
         "control_period": f(cfg.control_period), "integral_limit": f(cfg.integral_limit),
         "dwell_steps": int(cfg.dwell_steps),
         "kp": [f(v) for v in cfg.kp], "ki": [f(v) for v in cfg.ki], "kd": [f(v) for v in cfg.kd],
         "env_min": [f(v) for v in env_min], "env_max": [f(v) for v in env_max],
+        "wide_may_fly": int(wide_fly), "env_checks": envelope_checks(env_min, env_max),
+        "wide_note": ("an A_bd envelope wider than asin(2^-10): the network may still fly" if wide_fly else
+                      "the A_bd envelope lies inside +-asin(2^-10): a bound bit is set, the PID flies"),
     }
 
 

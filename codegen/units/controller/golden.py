@@ -33,8 +33,9 @@ def _chk(a: np.ndarray) -> np.ndarray:
     return a
 
 
-def unit_derivs(w, w1, w2):
-    inv = _chk(_f(1.0) / dm.sqrtf(v_dot(w, w)))
+def unit_derivs(w, w1, w2, inv=None):
+    if inv is None:
+        inv = _chk(_f(1.0) / dm.sqrtf(v_dot(w, w)))
     e = v_scale(w, inv)
     s1 = v_dot(e, w1)
     e1 = v_scale(v_sub(w1, v_scale(e, s1)), inv)
@@ -91,23 +92,23 @@ def target(cfg: cs.ControllerConfig, lon, lat, gmst):
 
 def desired(cfg: cs.ControllerConfig, R, V, t):
     r_t, v_t, a_t = t
-    r2 = v_dot(R, R)
-    a_s = v_scale(R, -(_f(cfg.mu) / (r2 * dm.sqrtf(r2))))
+    inv_r = _chk(_f(1.0) / dm.sqrtf(v_dot(R, R)))
+    a_s = v_scale(R, -((_f(cfg.mu) * inv_r) * (inv_r * inv_r)))
     z, z1, z2 = unit_derivs(v_sub(r_t, R), v_sub(v_t, V), v_sub(a_t, a_s))
     h = v_cross(R, V)
     n = v_scale(h, _f(1.0) / dm.sqrtf(v_dot(h, h)))
-    rh, rh1, rh2 = unit_derivs(R, V, a_s)
+    rh, rh1, rh2 = unit_derivs(R, V, a_s, inv_r)
     xo, xo1, xo2 = v_cross(n, rh), v_cross(n, rh1), v_cross(n, rh2)
     y, y1, y2 = unit_derivs(
         v_cross(z, xo),
         v_add(v_cross(z1, xo), v_cross(z, xo1)),
         v_add(v_add(v_cross(z2, xo), v_scale(v_cross(z1, xo1), _f(2.0))), v_cross(z, xo2)))
     x = v_cross(y, z)
-    x1 = v_add(v_cross(y1, z), v_cross(y, z1))
-    x2 = v_add(v_add(v_cross(y2, z), v_scale(v_cross(y1, z1), _f(2.0))), v_cross(y, z2))
-    wd = (v_dot(y1, z), v_dot(z1, x), v_dot(x1, y))
-    wdot = (_chk(v_dot(y2, z) + v_dot(y1, z1)), _chk(v_dot(z2, x) + v_dot(z1, x1)),
-            _chk(v_dot(x2, y) + v_dot(x1, y1)))
+    # x' and x'' never formed: x'.y = -(x.y'), x'.z' = y'.(z x z'), x'.y' = y'.(y x z')
+    yz1 = v_cross(y, z1)
+    wd = (v_dot(y1, z), v_dot(z1, x), _chk(-v_dot(x, y1)))
+    wdot = (_chk(v_dot(y2, z) + v_dot(y1, z1)), _chk(v_dot(z2, x) + v_dot(y1, v_cross(z, z1))),
+            _chk(-(v_dot(y1, yz1) + v_dot(x, y2))))
     return {"x": x, "y": y, "z": z, "xo": xo, "n": n, "rh": rh, "wd": wd, "wdot": wdot}
 
 
