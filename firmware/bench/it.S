@@ -35,3 +35,31 @@ BENCH bench_it_blocks
   bxeq lr
   bkpt #2
 END bench_it_blocks
+
+@ bench: bench_it_flash_read
+@ lenient: 13
+@ strict: 14
+@ An IT-conditional load from flash, then a translation block that starts with the IT block's
+@ condition false: that first instruction must run (profile.py clears the IT state Unicorn leaves
+@ behind a memory hook inside an IT block; without it `movs r0, #1` is skipped and r0 stays 0).
+@   movs r0, #0 ; cmp r0, #0              2 x 1                      = 2
+@   it eq                                 1                          = 1
+@   vldreq s0, 2f (runs: literal)         lenient 2, strict 3        = 2 | 3
+@   cmp r0, #1                            1                          = 1
+@   b 1f (taken, 1 + P; 16-bit target)    3                          = 3
+@   movs r0, #1                           1                          = 1
+@   bx lr                                 1 + P                      = 3
+BENCH bench_it_flash_read
+  movs r0, #0
+  cmp r0, #0
+  it eq
+  vldreq s0, 2f
+  cmp r0, #1
+  b 1f
+1:
+  movs r0, #1
+  bx lr
+  .p2align 2
+2:
+  .word 0x3f800000
+END bench_it_flash_read

@@ -159,7 +159,7 @@ class Decoder:
             c = ins.cost
             if members:
                 k = len(self.it_blocks[it_at])
-                cond = cond_pattern[0] if cond_pattern[k] == "t" else _INVERSE[cond_pattern[0]]
+                cond = cond_pattern[0] if cond_pattern[k + 1] == "t" else _INVERSE[cond_pattern[0]]
                 extra = (c.strict + c.taken_extra - 1, c.cycles + c.taken_extra - 1)
                 flags_changed = any(m[4] for m in self.it_blocks[it_at])
                 self.it_blocks[it_at].append((ins.addr, cond, extra, flags_changed, _sets_apsr(ins.text),
@@ -170,8 +170,8 @@ class Decoder:
             if c.it_count:
                 mnem, _, cond = ins.text.partition(" ")
                 members, it_at = c.it_count, ins.addr
-                cond_pattern = [cond.strip()] + list(mnem[2:])  # condition, then "t"/"e" per member
-                cond_pattern = [cond_pattern[0], "t", *cond_pattern[1:]]
+                # the condition, then "t" / "e" for each member (the first is always "t")
+                cond_pattern = [cond.strip(), "t", *mnem[2:]]
                 self.it_blocks[it_at] = []
         self.it_scanned.update(out)
         return out

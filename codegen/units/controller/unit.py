@@ -18,7 +18,7 @@ from codegen.units.controller.emit import (DEFAULT_NAME, INPUT_DTYPE, OUTPUT_DTY
                                            net_name)
 
 # SPEC section 8 budgets of the whole step as this generator meets them (ideal memory).
-BUDGETS = Budgets(cycles=5_000, cycles_art=5_500, flash=24 * 1024, ram=8 * 1024, stack=512)
+BUDGETS = Budgets(cycles=5_000, cycles_art=5_500, flash=24 * 1024, ram=16 * 1024, stack=512)
 
 
 class ControllerUnit(Unit):

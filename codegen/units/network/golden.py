@@ -7,7 +7,8 @@ Same IEEE operations in the same order as codegen/templates/network.c.j2:
   denormalise  y = (yn - ymin) / gain + xoffset
 Sums run as Python loops over the summation index and are vectorised across the batch and the
 neurons; never `@`, dot or sum (they reorder and may fuse). tanh is codegen.detmath.tanhf, the
-numpy twin of sg_tanhf (the C inlines it as sg_inline_tanhf, the same bits). Every stage
+numpy twin of sg_tanhf (the C computes it inline, two neurons at a time, from a signed copy of
+its table: the same bits). Every stage
 asserts float32 (numpy 2 promotes float32 with a float64 scalar to float64).
 """
 from __future__ import annotations
