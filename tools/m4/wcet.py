@@ -41,10 +41,9 @@ from tools.m4.decode import LINE_SHIFT, Decoder, Insn, literal_address, words_re
 from tools.m4.elf import Image
 from tools.m4.machine import FLASH
 from tools.m4.memory import ART_D_LINES, ART_I_LINES, WAIT_STATES
-from tools.m4.timing import FLOW_CALL, FLOW_COND, FLOW_JUMP, FLOW_NONE, entry_extra, pair
+from tools.m4.timing import FLOW_CALL, FLOW_COND, FLOW_NONE, TABLES, entry_extra, pair
 
 BOUND_MARK = re.compile(r"wcet: loop bound (\d+)(?: lines (\d+))?\b")
-TABLES = ("strict", "lenient")
 
 
 def _is_return(ins: Insn) -> bool:
