@@ -243,11 +243,12 @@ def build(sources: Mapping[str, str], adapter: str, opt: str = "-O2", peer: bool
     return ArmBuild(folder, folder / "firmware.elf", folder / "firmware.map", newlib)
 
 
-def bench_build(out_dir: Path) -> Path:
-    """Assemble the micro-benchmarks (firmware/bench/*.S) into one ELF in out_dir."""
+def bench_build(out_dir: Path, sources: list[Path] | None = None) -> Path:
+    """Assemble the micro-benchmarks (firmware/bench/*.S, or the given assembly files) into one
+    ELF in out_dir."""
     out_dir.mkdir(parents=True, exist_ok=True)
     elf = out_dir / "bench.elf"
-    sources = sorted(str(p) for p in BENCH.glob("*.S"))
+    sources = sorted(str(p) for p in (BENCH.glob("*.S") if sources is None else sources))
     cmd = [tool(ARM_CC), *ARM_CPU, "-g", "-I", str(BENCH), "-nostartfiles", "-nostdlib",
            "-T", str(LINKER_SCRIPT), "-Wl,-e,0", "-o", str(elf), *sources]
     res = _run(cmd, "assemble")

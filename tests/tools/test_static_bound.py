@@ -119,3 +119,42 @@ def test_network_hot_path_has_no_strict_stalls():
     assert n["FP result read by the next instruction"] == 0
     assert n["address written by the instruction just before"] == 0
     assert n["taken to a 32-bit halfword target"] == 0
+
+
+# ------------------------------------------------------------------ art: code beyond the cache
+
+BIG_STRAIGHT_LINE = """
+  .syntax unified
+  .thumb
+  .text
+  .global big
+  .type big, %function
+  .p2align 4
+big:
+  .rept 140
+  cmp r0, r0
+  bne.w 1f            @ never taken: each ends a block in the middle of a flash line
+  add.w r1, r1, #1
+  .endr
+1:
+  bx lr
+  .size big, . - big
+"""
+
+
+def test_art_bound_charges_a_line_shared_by_two_blocks_once(tmp_path):
+    # 1,402 bytes of straight-line code: more than the ART's 64 lines, so the bound charges
+    # block by block. Every line is fetched once (5 wait states); a block starting in the line the
+    # previous one ends in reads the ART's current line and must not be charged again.
+    src = tmp_path / "big.S"
+    src.write_text(BIG_STRAIGHT_LINE)
+    image = Image(bench_build(tmp_path, [src]))
+    fn = image.function("big")
+    lines = (fn.start + fn.size - 1) // 16 - fn.start // 16 + 1
+    assert lines > 64
+    bound = Analysis(image, tmp_path).bound("big")
+    run, = run_bench(image, "big")
+    for table in TABLES:
+        assert bound.cycles[(table, "art")] - bound.cycles[(table, "ideal")] == 5 * lines
+        assert run[table][1] - run[table][0] == 5 * lines
+        assert bound.cycles[(table, "art")] >= run[table][1]

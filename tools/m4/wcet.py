@@ -20,7 +20,8 @@ the profiler resolves timing at run time:
 Memory modes: `ideal` (0 wait states) and `art` (5 wait states, ART caches cold at the call). For
 `art`, every flash line of code a scope can fetch misses at most once per entry of a scope whose
 code fits the 64-line instruction cache (the scopes: the function with its callees, else each
-loop nest that fits, else every block execution misses on each of its lines); data reads from
+loop nest that fits, else every block execution misses on each of its lines but a first line
+that the block it follows, not through a call, ends in: the ART's current line); data reads from
 flash are literal-pool loads (their lines known, the same rule with the 8-line data cache) and,
 unless the image keeps no read-only data in flash, every other load, charged a miss each time.
 """
@@ -411,7 +412,7 @@ class Analysis:
         cycles = {}
         for table in TABLES:
             ideal = self._ipet(name, blocks, loops, start, lambda b, t=table: b.cost[t],
-                               lambda _b, _d, c, t=table: c[t], lambda b, t=table: sub[b.call].cycles[(t, "ideal")])
+                               lambda _b, _d, c, _k, t=table: c[t], lambda b, t=table: sub[b.call].cycles[(t, "ideal")])
             base = ideal + (entry_s if table == "strict" else 0)
             cycles[(table, "ideal")] = base
             cycles[(table, "art")] = base + sum(parts.values())
@@ -421,7 +422,7 @@ class Analysis:
         edges = [(None, start, 0.0)]  # the entry edge
         for b in blocks.values():
             for d, c, kind in b.succ:
-                w = float(edge_cost(b, d, c))
+                w = float(edge_cost(b, d, c, kind))
                 if b.call is not None:
                     w += call_cost(b)
                 if d is not None:
@@ -491,9 +492,13 @@ class Analysis:
         def block_cost(b: _Block) -> int:
             return 0 if b.addr in covered else WAIT_STATES * per_block(b)
 
-        def edge_cost(b: _Block, d, _c) -> int:
+        def edge_cost(b: _Block, d, _c, kind) -> int:
             if d in scopes and b.addr not in scopes[d][0]:
                 return WAIT_STATES * scopes[d][1]
+            if part == "code" and kind in ("fall", "taken") and d not in covered and _first_line(blocks[d]) == _last_line(b):
+                # d starts in the line b ends in: the ART's current instruction line, no miss
+                # (RM0090 3.5.2). Not after a call: the callee may have evicted it.
+                return -WAIT_STATES
             return 0
 
         def call_cost(b: _Block) -> int:
@@ -530,6 +535,15 @@ class Analysis:
                 code |= c
                 lits |= lt
         return code, lits
+
+
+def _first_line(b: _Block) -> int:
+    return b.insns[0].addr >> LINE_SHIFT
+
+
+def _last_line(b: _Block) -> int:
+    last = b.insns[-1]
+    return (last.addr + last.size - 1) >> LINE_SHIFT
 
 
 def _code_lines(b: _Block) -> int:
