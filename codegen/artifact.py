@@ -115,7 +115,8 @@ def is_float32_exact(value: float) -> bool:
 
 @dataclass(frozen=True)
 class MapMinMax:
-    """MATLAB mapminmax settings of one side of the network; applied in float32 by the flight C.
+    """MATLAB mapminmax settings of one side of the network; the flight C has them folded into the
+    layers (codegen/units/network/fold.py), the float64 reference applies them as written.
 
     y = (x - xoffset) * gain + ymin,   x = (y - ymin) / gain + xoffset.
     xmin/xmax are the raw data ranges (float64, as given); xoffset/gain are float32.

@@ -11,9 +11,10 @@ The same 12-40-3 network (an artifact file, e.g. a trained one, or a seeded rand
 each run over the input classes of `staregen cycles` (inside the envelope, edges, outside,
 special values) under the cycle model in the three memory modes, plus the paper's 3.1 ms.
 
-emlearn's C has no mapminmax: it gets the normalised inputs (codegen.units.network.golden.normalise, float32,
-the same xn our MLP sees) and its normalised outputs are mapped back on the host in float64, so
-its cycles are those of the MLP alone and its error that of its MLP and libm tanhf.
+emlearn's C has no mapminmax: it gets the normalised inputs (MATLAB's mapminmax in float32 on the host,
+mapminmax_f32 below; our C has the map folded into its first layer instead) and its normalised outputs
+are mapped back on the host in float64, so its cycles are those of the MLP alone and its error that of
+its MLP and libm tanhf.
 
 Usage:  python tools/bench_network.py [--artifact A.json] [--per-class 250] [--md out.md]
 """
@@ -122,6 +123,13 @@ def emlearn_sources(a: art.Artifact, fast_tanh: bool = False) -> dict[str, str]:
     return sources
 
 
+def mapminmax_f32(a: art.Artifact, x: np.ndarray) -> np.ndarray:
+    """MATLAB's mapminmax of the inputs in float32, (x - xoffset) * gain + ymin: emlearn's inputs."""
+    m = a.input_map
+    with np.errstate(all="ignore"):
+        return ((x - m.xoffset) * m.gain + np.float32(m.ymin)).astype(np.float32)
+
+
 def emlearn_row(a: art.Artifact, classes: dict[str, np.ndarray], fast_tanh: bool = False) -> Row:
     import emlearn
 
@@ -130,7 +138,7 @@ def emlearn_row(a: art.Artifact, classes: dict[str, np.ndarray], fast_tanh: bool
                                  layout_checks=[f"{P}_N_IN == {a.n_in}", f"{P}_N_OUT == {a.n_out}"],
                                  input_words=a.n_in, output_words=a.n_out, state_words=0)
     build = arm.build(emlearn_sources(a, fast_tanh), adapter, opt="-O2", peer=True)
-    xn_classes = {c: golden.normalise(a, x) for c, x in classes.items()}
+    xn_classes = {c: mapminmax_f32(a, x) for c, x in classes.items()}
     prof = _profile(build.elf, f"{EML_NAME}_eval", xn_classes)
     yn = _eval(build.elf, xn_classes["inside"], a.n_out)
     om = a.output_map

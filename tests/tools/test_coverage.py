@@ -19,7 +19,7 @@ class Planted(NetworkUnit):
     def sources(self):
         files = dict(super().sources())
         files["network.c"] = files["network.c"].replace(
-            "    y[1] = ", "    if (q1 > 0x1p+120f) {   /* PLANTED: never true */\n        y[0] = 0.0f;\n    }\n"
+            "    y[1] = ", "    if (s1 > 0x1p+120f) {   /* PLANTED: never true */\n        y[0] = 0.0f;\n    }\n"
             "    y[1] = ", 1)
         return files
 
@@ -27,9 +27,6 @@ class Planted(NetworkUnit):
 # Functions of a network's C that no step runs: the integrity check (called at start-up) and the
 # stage functions kept for the stage-by-stage tests (<name>_eval runs the stages without them).
 NOT_IN_THE_STEP = ("tables_crc32", "normalise", "mlp", "denormalise")
-# The one branch of the step a network unit's gate cannot take: <name>_hidden's `denormalise`
-# flag is 0 only for the mlp stage function.
-STAGE_ONLY = "if denormalise != 0 {"
 
 
 def outside_the_step(text: str, name: str = "network") -> set[int]:
@@ -47,19 +44,17 @@ def outside_the_step(text: str, name: str = "network") -> set[int]:
 def test_network_lines_all_run_and_a_planted_branch_is_untaken():
     clean = measure(NetworkUnit(ARTIFACT), n=2_000)
     net = clean.files["network.c"]
-    # every line of the step runs (not the functions outside it) and every branch is taken but the
-    # mlp stage's one
+    # every line of the step runs (not the functions outside it) and every branch is taken
     text = NetworkUnit(ARTIFACT).sources()["network.c"]
     skip = outside_the_step(text)
     assert 0 < net.lines - net.lines_hit <= len(skip)
     untaken = [ln for ln, _ in net.untaken if ln not in skip]
-    assert [_bare(text.splitlines()[ln - 1].strip()) for ln in untaken] == [_bare(STAGE_ONLY)]
+    assert [_bare(text.splitlines()[ln - 1].strip()) for ln in untaken] == []
     planted = Planted(ARTIFACT)
     rep = measure(planted, n=2_000)
     source = planted.sources()["network.c"]
     text, skip = source.splitlines(), outside_the_step(source)
-    untaken = [ln for ln, _ in rep.files["network.c"].untaken
-               if ln not in skip and _bare(text[ln - 1].strip()) != _bare(STAGE_ONLY)]
+    untaken = [ln for ln, _ in rep.files["network.c"].untaken if ln not in skip]
     assert untaken and all("PLANTED" in text[ln - 1] for ln in untaken)
     lines = report_lines(rep, planted.sources())
     assert any("PLANTED" in ln and "network.c:" in ln for ln in lines)
@@ -80,9 +75,9 @@ UNREACHABLE = {
                    "A_bd[1] = bx1 != 0u ?", "A_bd[2] = bx2 != 0u ?",
                    "if update_modestate, status == 0u ? 1u : 0u == 0u && may_fly != 0u {",
                    "status |= CONTROLLER_STATUS_PID | status == 0u ? CONTROLLER_STATUS_DWELL : 0u;",
-                   STAGE_ONLY, "} else if ib < CONTROLLER_NN_TANH_HALF {", "y[0] = q0 != q0 ? nan.f : q0;",
-                   "y[1] = q1 != q1 ? nan.f : q1;", "y[2] = q2 != q2 ? nan.f : q2;"),
-    "network": (STAGE_ONLY,),
+                   "} else if ib < CONTROLLER_NN_TANH_HALF {", "y[0] = s0 != s0 ? nan.f : s0;",
+                   "y[1] = s1 != s1 ? nan.f : s1;", "y[2] = s2 != s2 ? nan.f : s2;"),
+    "network": (),
     "tanh": (),
 }
 NETWORK_FILE = {"controller": ("controller_nn.c", "controller_nn"), "network": ("network.c", "network")}

@@ -41,12 +41,12 @@ def test_clean_units_fuzz_clean(capsys, tmp_path):
 
 
 def test_an_out_of_bounds_write_is_a_sanitizer_report():
-    unit = Planted(ARTIFACT, "    y[2] = ", "    y[2 + (q2 > 0.0f)] = ")   # index 3 on about half the rows
+    unit = Planted(ARTIFACT, "    y[2] = ", "    y[2 + (s2 > 0.0f)] = ")   # index 3 on about half the rows
     with pytest.raises(ToolError, match="sanitizer report: .*(stack-buffer-overflow|AddressSanitizer)"):
         fuzz(unit, 1000, log=lambda _: None)
 
 
 def test_a_changed_operation_is_a_mismatch():
-    unit = Planted(ARTIFACT, "q0 = s0 - NETWORK_OUT_YMIN;", "q0 = s0 + NETWORK_OUT_YMIN;")
+    unit = Planted(ARTIFACT, "s0 = s0 + (o0 * h.a);", "s0 = s0 - (o0 * h.a);")
     result = fuzz(unit, 2000, log=lambda _: None)
     assert result.mismatches > 0 and not result.ok

@@ -82,10 +82,10 @@ def test_generation_is_deterministic(package, tmp_path):
 
 
 def flip_weight_bit(folder: Path) -> None:
-    """Flip the top mantissa bit (bit 22) of the first hidden-layer weight W1[0][0]."""
+    """Flip the top mantissa bit (bit 22) of the first hidden-layer weight W1'[0][0] (folded)."""
     path = folder / "src" / "stare_nn.c"
     text = path.read_text()
-    at = text.index("/* W1 */")
+    at = text.index("/* W1' */")
     m = re.compile(r"0x1\.([0-9a-f])").search(text, at)
     digit = format(int(m.group(1), 16) ^ 8, "x")
     path.write_text(text[:m.start(1)] + digit + text[m.end(1):])

@@ -1,4 +1,4 @@
-"""Unit `network`: the normalise -> MLP -> denormalise path of a model artifact."""
+"""Unit `network`: the normalise -> MLP -> denormalise path of a model artifact (mapminmax folded into the layers)."""
 from codegen.artifact import random_artifact
 from codegen.unit import UnitKind
 from codegen.units.network.unit import configure

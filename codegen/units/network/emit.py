@@ -14,6 +14,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION, detmath
 from codegen.artifact import Artifact
 from codegen.cgen import c_float, check_name, comment, environment, math_sources, write_sources
+from codegen.units.network.fold import Folded, fold
 
 TEMPLATES = Path(__file__).with_name("templates")
 DEFAULT_NAME = "network"
@@ -36,13 +37,13 @@ def _labels(names, units, descriptions, lows=None, highs=None) -> list[dict]:
     return rows
 
 
-def _neurons(a: Artifact) -> list[dict]:
-    """Per hidden neuron, the constants in the order the MLP loop consumes them."""
+def _neurons(f: Folded) -> list[dict]:
+    """Per hidden neuron, the folded constants in the order the MLP loop consumes them."""
     return [
-        {"bias": c_float(a.b1[j]),
-         "w_in": [c_float(w) for w in a.W1[j]],
-         "w_out": [c_float(w) for w in a.W2[:, j]]}
-        for j in range(a.n_hidden)
+        {"bias": c_float(f.b1[j]),
+         "w_in": [c_float(w) for w in f.W1[j]],
+         "w_out": [c_float(w) for w in f.W2[:, j]]}
+        for j in range(f.W1.shape[0])
     ]
 
 
@@ -82,39 +83,51 @@ def tanh_rows() -> np.ndarray:
     return np.concatenate([neg[::-1], pos]).astype(np.float32)
 
 
-# FPU registers the normalisation may use without saving any (s0-s15, AAPCS caller-saved).
+# FPU registers the input stage may use without saving any (s0-s15, AAPCS caller-saved).
 CALLER_SAVED_S = 16
 
 
-def normalise_chunks(n_in: int) -> list[list[int]]:
-    """Inputs normalised together: each chunk's x, offsets and gains (3 registers per input) are
-    loaded as one group beside the inputs already done, within CALLER_SAVED_S registers; the
-    fewer the chunks, the fewer the load groups (each costs a cycle)."""
+def input_chunks(centred) -> list[list[dict]]:
+    """The inputs in order, cut into groups loaded back to back: {"i": input, "c": its index in
+    <name>_in_xoffset or None for a raw input}. A group's loads (one register per raw input, two
+    per centred one: x and its offset) sit beside the inputs already done, within CALLER_SAVED_S
+    registers; the fewer the groups, the fewer the load runs (each costs a cycle)."""
+    rows, c = [], 0
+    for i, is_centred in enumerate(centred):
+        rows.append({"i": i, "c": c if is_centred else None})
+        c += bool(is_centred)
     chunks, done = [], 0
-    while done < n_in:
-        size = max(1, min(n_in - done, (CALLER_SAVED_S - done) // 3))
-        chunks.append(list(range(done, done + size)))
+    while done < len(rows):
+        regs, size = done, 0
+        while done + size < len(rows) and regs + (1 if rows[done + size]["c"] is None else 2) <= CALLER_SAVED_S:
+            regs += 1 if rows[done + size]["c"] is None else 2
+            size += 1
+        size = max(size, 1)
+        chunks.append(rows[done:done + size])
         done += size
     return chunks
 
 
 def tables_crc32(a: Artifact) -> int:
     """zlib's CRC-32 of the network's constant tables in the C's order and layout (little-endian
-    float32), the signed tanh table (the path's tanh: it no longer reads sg_math's sg_tanh_tab)
-    last: what <name>_tables_crc32() computes on the target."""
-    neurons = np.concatenate([a.b1[:, None], a.W1, a.W2.T], axis=1)
+    float32): the folded neurons, b2', the offsets of the centred inputs (if any), then the signed
+    tanh table (the path's tanh: it no longer reads sg_math's sg_tanh_tab): what
+    <name>_tables_crc32() computes on the target."""
+    f = fold(a)
+    neurons = np.concatenate([f.b1[:, None], f.W1, f.W2.T], axis=1)
+    tables = [neurons, f.b2] + ([f.xoffset] if f.centred_inputs else []) + [tanh_rows()]
     crc = 0
-    for table in (neurons, a.b2, a.input_map.xoffset, a.input_map.gain, a.output_map.xoffset, a.output_map.gain,
-                  tanh_rows()):
+    for table in tables:
         crc = zlib.crc32(np.ascontiguousarray(table, dtype="<f4").tobytes(), crc)
     return crc
 
 
 def template_context(a: Artifact, name: str) -> dict:
     env, out = a.envelope, a.outputs
+    f = fold(a)
     return {
         "unroll": hidden_unroll(a.n_hidden), "stride": 1 + a.n_in + a.n_out,
-        "load_groups": load_groups(a.n_in), "normalise_chunks": normalise_chunks(a.n_in),
+        "load_groups": load_groups(a.n_in), "input_chunks": input_chunks(f.centred),
         "name": name, "P": name.upper(),
         "n_in": a.n_in, "n_hidden": a.n_hidden, "n_out": a.n_out,
         "sha256": a.sha256, "generator_version": GENERATOR_VERSION,
@@ -122,17 +135,15 @@ def template_context(a: Artifact, name: str) -> dict:
         "envelope_source": comment(env.source),
         "inputs": _labels(env.names, env.units, env.descriptions, env.min, env.max),
         "outputs": _labels(out.names, out.units, out.descriptions),
-        "neurons": _neurons(a),
+        "input_modes": [{"index": i, "mode": "centred" if c else "raw", "ratio": f"{r:.6g}"}
+                        for i, (c, r) in enumerate(zip(f.centred, f.ratio))],
+        "neurons": _neurons(f),
         "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
         "tanh_half": TANH_HALF, "tanh_cols": TANH_COLS,
         "tables_crc32": f"0x{tables_crc32(a):08x}",
-        "b2": [c_float(v) for v in a.b2],
-        "in_xoffset": [c_float(v) for v in a.input_map.xoffset],
-        "in_gain": [c_float(v) for v in a.input_map.gain],
-        "in_ymin": c_float(a.input_map.ymin),
-        "out_xoffset": [c_float(v) for v in a.output_map.xoffset],
-        "out_gain": [c_float(v) for v in a.output_map.gain],
-        "out_ymin": c_float(a.output_map.ymin),
+        "b2": [c_float(v) for v in f.b2],
+        "centred": f.centred_inputs,
+        "in_xoffset": [c_float(v) for v in f.xoffset],
     }
 
 

@@ -2,7 +2,10 @@
 
 Stateless: input record `x` (n_in float32, Table 2 units), output record `y` (n_out float32,
 N·m); the C entry is `<name>_eval(const float x[], float y[])`, and normalise / mlp /
-denormalise are exposed as stages for the stage-by-stage tests.
+denormalise are exposed as stages for the stage-by-stage tests. mapminmax is folded into the
+layers at generation (fold.py), so the stages are what is left at run time: normalise the
+subtraction of the centred inputs' offsets, mlp the folded MLP (raw output units), denormalise
+the canonical-NaN rule.
 """
 from __future__ import annotations
 

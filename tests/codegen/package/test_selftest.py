@@ -83,9 +83,9 @@ def test_selftest_passes_and_counts_planted_faults(tmp_path, package_sources):
     files, vectors = package_sources
     (tmp_path / "ok").mkdir()
     assert run(build(tmp_path / "ok", files)) == (0, 0)
-    # flip the top mantissa bit (bit 22) of the first hidden-layer weight W1[0][0]
+    # flip the top mantissa bit (bit 22) of the first hidden-layer weight W1'[0][0] (folded)
     nn = files["stare_nn.c"]
-    m = re.compile(r"0x1\.([0-9a-f])").search(nn, nn.index("/* W1 */"))
+    m = re.compile(r"0x1\.([0-9a-f])").search(nn, nn.index("/* W1' */"))
     bad = dict(files, **{"stare_nn.c": nn[:m.start(1)] + format(int(m.group(1), 16) ^ 8, "x") + nn[m.end(1):]})
     (tmp_path / "bad").mkdir()
     mismatches, env = run(build(tmp_path / "bad", bad))

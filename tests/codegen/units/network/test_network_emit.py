@@ -12,7 +12,7 @@ from codegen import GENERATOR_VERSION
 from codegen import artifact as art
 from codegen.cgen import c_float, write_sources
 from codegen.errors import CodegenError
-from codegen.units.network import emit
+from codegen.units.network import emit, fold
 from codegen.units.network.unit import NetworkUnit
 from firmware import flags, x86
 from firmware.errors import FirmwareError
@@ -63,14 +63,63 @@ def test_header_carries_sha256_version_units_and_api(artifact, sources):
 
 
 def test_constants_are_exact_and_in_consumption_order(artifact, sources):
+    """The C's constants are the folded layers (fold.py), bit for bit, packed per neuron."""
     c = sources["network.c"]
+    f = fold.fold(artifact)
     table = c[c.index("network_neurons[NETWORK_N_HIDDEN]"):c.index("network_b2[NETWORK_N_OUT]")]
     got = np.array(hex_literals(table), dtype=np.float64)
-    want = np.concatenate([np.concatenate([[artifact.b1[j]], artifact.W1[j], artifact.W2[:, j]])
+    want = np.concatenate([np.concatenate([[f.b1[j]], f.W1[j], f.W2[:, j]])
                            for j in range(artifact.n_hidden)]).astype(np.float64)
     np.testing.assert_array_equal(got, want)
-    gains = c[c.index("network_in_gain["):].split(";")[0]
-    np.testing.assert_array_equal(np.array(hex_literals(gains)), artifact.input_map.gain.astype(np.float64))
+    b2 = c[c.index("network_b2[NETWORK_N_OUT] ="):].split(";")[0]
+    np.testing.assert_array_equal(np.array(hex_literals(b2)), f.b2.astype(np.float64))
+    # this artifact's training ranges are symmetric (or [-1.2, 0]): every input is raw, no offset table
+    assert f.centred_inputs == [] and "network_in_xoffset[" not in c
+    assert not re.search(r"static const float network_\w*(gain|ymin)", c)  # mapminmax is in the layers
+    code = re.sub(r"/\*.*?\*/", "", c, flags=re.S)
+    assert not re.search(r"[\w)\]] / [\w(]", code)  # no division left
+
+
+def test_folded_layers_are_mapminmax_moved_into_the_weights():
+    """fold.py against an independent float64 reading of MATLAB's formulas: W1' and W2' are the
+    float32 of the exact products / quotients, the biases within an ulp of a plain float64 sum, and
+    the folded affine maps equal the unfolded ones in float64 (for centred and raw inputs alike)."""
+    a = art.random_artifact((5, 17, 2), seed=1)  # ranges far from 0: centred inputs, and raw ones
+    f = fold.fold(a)
+    im, om = a.input_map, a.output_map
+    assert f.centred == tuple(bool(r > fold.RAW_MAX_RATIO) for r in f.ratio)
+    assert 0 < len(f.centred_inputs) < a.n_in
+    W1, b1 = a.W1.astype(np.float64), a.b1.astype(np.float64)
+    W2, b2 = a.W2.astype(np.float64), a.b2.astype(np.float64)
+    gain, xoff = im.gain.astype(np.float64), im.xoffset.astype(np.float64)
+    np.testing.assert_array_equal(f.W1, (W1 * gain).astype(np.float32))
+    np.testing.assert_array_equal(f.W2, (W2 / om.gain.astype(np.float64)[:, None]).astype(np.float32))
+    raw = ~np.array(f.centred)
+    b1_want = b1 + float(im.ymin) * W1.sum(axis=1) - (f.W1.astype(np.float64)[:, raw] * xoff[raw]).sum(axis=1)
+    b2_want = (b2 - float(om.ymin)) / om.gain.astype(np.float64) + om.xoffset.astype(np.float64)
+    for got, want in ((f.b1, b1_want), (f.b2, b2_want)):
+        assert np.all(np.abs(got.astype(np.float64) - want) <= np.spacing(np.abs(want).astype(np.float32))), (got, want)
+    np.testing.assert_array_equal(f.xoffset, im.xoffset[np.array(f.centred)])
+    # the folded maps, float64, on points of the training range
+    x = np.random.default_rng(0).uniform(im.xmin, im.xmax, size=(100, a.n_in))
+    v = np.where(np.array(f.centred), x - xoff, x)
+    acc = v @ f.W1.astype(np.float64).T + f.b1
+    acc_ref = ((x - xoff) * gain + float(im.ymin)) @ W1.T + b1
+    np.testing.assert_allclose(acc, acc_ref, rtol=0, atol=1e-5 * np.abs(acc_ref).max())
+    h = np.tanh(acc_ref)
+    y = h @ f.W2.astype(np.float64).T + f.b2
+    y_ref = (h @ W2.T + b2 - float(om.ymin)) / om.gain.astype(np.float64) + om.xoffset.astype(np.float64)
+    np.testing.assert_allclose(y, y_ref, rtol=0, atol=1e-6 * (om.xmax - om.xmin).max())
+
+
+def test_a_raw_input_is_one_whose_range_is_not_far_from_symmetric():
+    assert list(fold.range_ratio([-1, -2, 3, 0, -1.2, 5], [1, 1, 4, 0, 0, 5])) == [0.5, 2 / 3, 4, np.inf, 1, np.inf]
+    src = emit.network_sources(art.random_artifact((5, 17, 2), seed=1))["network.c"]
+    f = fold.fold(art.random_artifact((5, 17, 2), seed=1))
+    assert f"#define NETWORK_N_CENTRED {len(f.centred_inputs)}" in src
+    for i, c in enumerate(f.centred):
+        assert f" *   x[{i}] {'centred' if c else 'raw'} (" in src
+        assert (f"v{i} = x{i} - o{i};" in src) == c and (f"v{i} = x{i};" in src) == (not c)
 
 
 def test_c_float_literals_round_trip():

@@ -9,7 +9,7 @@ import host.cli as cli
 import tools.gate
 from codegen import artifact as art
 from codegen import bitcompare
-from codegen.units.network import golden, reference, vectors
+from codegen.units.network import fold, golden, reference, vectors
 from codegen.units.network.unit import NetworkUnit
 from tools.runners import X86Runner
 
@@ -104,12 +104,15 @@ def test_gate_detects_a_one_ulp_weight_change(net12):
 def test_gate_detects_a_reordered_sum(net12):
     """Adding the bias last instead of first (same maths, other rounding) must not pass."""
     a, lib = net12
+    f = fold.fold(a)
     xn = golden.normalise(a, vectors.gate_vectors(a.envelope, 2_000, 0).x)
     acc = np.zeros((xn.shape[0], a.n_hidden), np.float32)
     with np.errstate(all="ignore"):  # the vectors include Inf/NaN rows
         for i in range(a.n_in):
-            acc = acc + a.W1[:, i] * xn[:, i, None]
-    reordered = golden.output_layer(a, golden.tansig(acc + a.b1))
+            acc = acc + f.W1[:, i] * xn[:, i, None]
+    in_order = golden.output_layer(a, golden.tansig(golden.hidden_preactivation(a, xn)))
+    assert_bits_equal(in_order, lib.mlp(xn), inner_stage=True)  # the same, bias first: identical
+    reordered = golden.output_layer(a, golden.tansig(acc + f.b1))
     assert bitcompare.compare(reordered, lib.mlp(xn)).n_mismatches > 100
 
 
@@ -128,8 +131,9 @@ def test_golden_refuses_float64_and_uses_no_reordering_or_library_math():
     a = art.random_artifact((5, 17, 2), 0)
     with pytest.raises(ValueError, match="float32"):
         golden.network_eval(a, np.zeros((3, 5)))
-    for fn in (golden.normalise, golden.hidden_preactivation, golden.tansig, golden.output_layer,
-               golden.denormalise, golden.network_eval):
+    for fn in (golden.normalise, golden._normalise, golden.hidden_preactivation, golden._hidden_preactivation,
+               golden.tansig, golden.output_layer, golden._output_layer, golden._mlp, golden.mlp,
+               golden.denormalise, golden._canonical, golden.network_eval):
         src = inspect.getsource(fn)
         for banned in (" @ ", ".dot(", "np.sum", ".sum(", "np.tanh", "np.exp", "einsum", "matmul", "float64"):
             assert banned not in src, (fn.__name__, banned)
