@@ -21,6 +21,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION, detmath
 from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 from codegen.errors import CodegenError
+from codegen.units.network.emit import TANH_COLS, TANH_HALF, tanh_rows
 from codegen.units.tanh.params import TanhParams, derived_constants
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -132,6 +133,8 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
         "pow_gamma_m1": detmath.powc_c_initializer(detmath.powc_tables(c.gamma_m1)),
         "pow_gamma": detmath.powc_c_initializer(detmath.powc_tables(c.gamma)),
+        "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
+        "tanh_half": TANH_HALF, "tanh_cols": TANH_COLS,
     }
 
 
