@@ -22,6 +22,7 @@ from codegen import GENERATOR_VERSION, detmath
 from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 from codegen.errors import CodegenError
 from codegen.units.network.emit import TANH_COLS, TANH_HALF, tanh_rows
+from codegen.units.tanh.powtab import PowTab, pow_tables
 from codegen.units.tanh.params import TanhParams, derived_constants
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -69,6 +70,7 @@ def constants32(p: TanhParams, period: float) -> Constants32:
         "eps1": p.eps1, "eps2": p.eps2, "eps3": p.eps3,
         "nbeta1": -p.beta1, "beta2": p.beta2, "gamma": p.gamma, "gamma_m1": p.gamma - 1.0, "eta": p.eta,
         "r1": d["r1"], "r2": d["r2"], "r2x2": 2.0 * d["r2"],
+        "br1": p.beta2 * d["r1"], "br2": p.beta2 * d["r2"], "br2x2": 2.0 * p.beta2 * d["r2"],
         "lam": p.lam, "nlam2": -2.0 * p.lam,
         "k4": p.k4, "k5": p.k5, "d_max": p.d_max, "delta_reg": p.delta_reg, "n1": p.n1,
         "ua_gain": d["ua_gain"], "ua_inner": d["ua_inner_scale"],
@@ -108,12 +110,31 @@ def sqrt_gt_threshold(n1: np.float32) -> np.float32:
     return np.float32(d)
 
 
+def shaping_pow(c: Constants32) -> PowTab:
+    """beta2 |x|^(gamma - 1) of f (11) (gamma - 1 the float32 constant)."""
+    return pow_tables(c.gamma_m1, c.beta2)
+
+
+def compensation_pow(c: Constants32) -> PowTab:
+    """||J^-1|| d_max sig(delta)^gamma / n1^gamma of u_a (20)."""
+    return pow_tables(c.gamma, c.ua_inner)
+
+
+def pow_initializer(t: PowTab, indent: str = "    ") -> str:
+    """C initializer of a <name>_pow_*_t: {p0, p1}, the rows {c, 1/c, c^y, 0}, ek (8 per line)."""
+    rows = (",\n" + indent * 2).join("{" + ", ".join(c_float(v) for v in r) + "}" for r in t.rows)
+    ek = (",\n" + indent * 2).join(", ".join(c_float(v) for v in t.ek[i:i + 8]) for i in range(0, len(t.ek), 8))
+    return ("{\n" + indent + "{" + c_float(t.p0) + ", " + c_float(t.p1) + "},\n" + indent + "{\n" + indent * 2
+            + rows + "\n" + indent + "},\n" + indent + "{\n" + indent * 2 + ek + "\n" + indent + "}\n}")
+
+
 def template_context(p: TanhParams, period: float, name: str) -> dict:
     c = constants32(p, period)
     if not c.eta >= np.finfo(np.float32).tiny:
         # f's power branch (|x| > eta) reads |x| as a positive normal float: no slow path there
         raise CodegenError(f"eta = {p.eta!r} is below the smallest normal float32 (1.18e-38)")
     literal = {k: c_float(v) for k, v in c.scalars.items()}
+    pow_f, pow_u = shaping_pow(c), compensation_pow(c)
     literal["n1_dsq"] = c_float(sqrt_gt_threshold(c.n1))
     literal["J"] = [c_float(v) for v in c.J]
     literal["J_inv"] = [c_float(v) for v in c.J_inv]
@@ -131,8 +152,9 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "period": c_float(c.period), "period_text": _text(period),
         "limit_text": _text(p.varpi_limit), "q0_min_text": _text(p.q0_min),
         "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
-        "pow_gamma_m1": detmath.powc_c_initializer(detmath.powc_tables(c.gamma_m1)),
-        "pow_gamma": detmath.powc_c_initializer(detmath.powc_tables(c.gamma)),
+        "pow_f": pow_f, "pow_u": pow_u,
+        "pow_f_init": pow_initializer(pow_f), "pow_u_init": pow_initializer(pow_u),
+        "eta_bits": f"0x{int(c.eta.view(np.uint32)):08x}",
         "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
         "tanh_half": TANH_HALF, "tanh_cols": TANH_COLS,
     }

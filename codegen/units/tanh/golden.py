@@ -21,7 +21,10 @@ import numpy as np
 
 from codegen import detmath
 from codegen.golden_vec3 import f32, v3, v_cross, v_dot, v_sub
-from codegen.units.tanh.emit import INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, Constants32
+from codegen.units.tanh import powtab
+from codegen.units.tanh.emit import (INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, Constants32, compensation_pow,
+                                     shaping_pow)
+from codegen.units.tanh.powtab import PowTab
 
 F32 = np.float32
 STATUS_OK, STATUS_SINGULAR, STATUS_INVALID_INPUT = 0, 1, 2
@@ -54,27 +57,28 @@ def e_solve(q0, inv_q0, kk, e, v):
     return v3(*(kk * ((q0 * v[i] - c[i]) + e[i] * ev) for i in range(3)))
 
 
+def pow_scaled(x, t: PowTab):
+    """K x^y from the bits of x (sign included) by powtab's tables, as the C's <name>_pow_*3."""
+    u = x.view(np.uint32)
+    i = u + np.uint32(powtab.BIAS)
+    row = t.rows[((i >> np.uint32(t.shift)) & np.uint32(t.n - 1)).astype(np.intp)]
+    z = ((i & np.uint32(0x007FFFFF)) + np.uint32(powtab.Z0)).view(F32)
+    ek = t.ek[(i >> np.uint32(23)).astype(np.intp)]
+    r = f32((z - row[..., 0]) * row[..., 1], "pow r")
+    q = r * (t.p1 * r + t.p0)
+    s = row[..., 2] * ek
+    return f32(s + s * q, "pow")
+
+
 def shaping(k: Constants32, x):
-    """(f(x), f'(x)) of eq. 11 as the C computes them."""
+    """(β2 f(x), β2 f'(x)) of eq. 11 as the C computes them: q = β2|x|^(γ-1) by the table, β2 f = x q,
+    β2 f' = γ q outside η; the patch with β2 folded into its constants inside."""
     ax = np.abs(x)
     inside = ax <= k.eta
-    q = detmath.powf_const(ax, detmath.powc_tables(k.gamma_m1))  # |x|^(γ-1): f = sign(x)|x|q, f' = γq (no division)
-    p = ax * q
-    f = np.where(inside, k.r1 * x + (k.r2 * x) * ax, np.where(x < F32(0.0), -p, p))
-    slope = np.where(inside, k.r1 + k.r2x2 * ax, k.gamma * q)
-    return f32(f, "shaping"), f32(slope, "shaping slope")
-
-
-def positive_normal(x) -> np.ndarray:
-    """x is a positive normal float32 (the C's (bits - 0x00800000) < 0x7f000000)."""
-    return (x.view(np.uint32) - np.uint32(0x00800000)) < np.uint32(0x7F000000)
-
-
-def sig_pow(k: Constants32, d):
-    """{name}_sig_pow: sg_powf_const's table path for |d| a positive normal float, else +0."""
-    ad = np.abs(d)
-    p = np.where(positive_normal(ad), detmath.powf_const(ad, detmath.powc_tables(k.gamma)), F32(0.0))
-    return f32(np.where(d < F32(0.0), -p, p), "sig_pow")
+    q = pow_scaled(ax, shaping_pow(k))
+    bf = np.where(inside, k.br1 * x + (k.br2 * x) * ax, x * q)
+    bs = np.where(inside, k.br1 + k.br2x2 * ax, k.gamma * q)
+    return f32(bf, "shaping"), f32(bs, "shaping slope")
 
 
 def force_terms(k: Constants32, re, w_c, w_e, wdot_t, w_ev_dot, u):
@@ -91,7 +95,7 @@ def compensation(k: Constants32, delta, dsq):
     norm = detmath.sqrtf(dsq)
     outer = norm > k.n1
     kk = k.ua_gain / norm
-    return v3(*(np.where(outer, kk * delta[i], k.ua_inner * sig_pow(k, delta[i])) for i in range(3)))
+    return v3(*(np.where(outer, kk * delta[i], pow_scaled(delta[i], compensation_pow(k))) for i in range(3)))
 
 
 def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
@@ -103,14 +107,15 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     inv_om = m * rr
     barrier = k.lam * detmath.logf_tab(om)
     fs = [shaping(k, x1[i]) for i in range(3)]
-    g = v3(*((k.nbeta1 * x1[i] - k.beta2 * fs[i][0]) + barrier * x1[i] for i in range(3)))
+    c1 = k.nbeta1 + barrier
+    g = v3(*(c1 * x1[i] - fs[i][0] for i in range(3)))
     w_ev = e_solve(q0, inv_q0, kk, x1, g)
     x2 = v_sub(w_e, w_ev)
     x1_dot = e_apply(q0, x1, w_e)
     q0_dot = F32(-0.5) * v_dot(x1, w_e)
     e_dot_w = e_apply(q0_dot, x1_dot, w_ev)
     radial = (k.nlam2 * v_dot(x1, x1_dot)) * inv_om
-    dg = v3(*(((k.nbeta1 - k.beta2 * fs[i][1]) + barrier) * x1_dot[i] + radial * x1[i] for i in range(3)))
+    dg = v3(*((c1 - fs[i][1]) * x1_dot[i] + radial * x1[i] for i in range(3)))
     dg = v_sub(dg, e_dot_w)
     w_ev_dot = e_solve(q0, inv_q0, kk, x1, dg)
     u = v3(*((k.nk1 * detmath.tanhf(k.eps1 * varpi[i]) - k.k2 * detmath.tanhf(k.eps2 * x1[i]))
@@ -198,7 +203,7 @@ def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray
                                                  vec("wdot_t"))
         ok = state_ok & inputs_ok
         zero = np.zeros(inp.shape[0], dtype=F32)
-        result_ok = sum_is_finite(u + vdot + x1 + x2)   # telemetry too: no output is ever NaN or Inf
+        result_ok = sum_is_finite(vdot + x1)   # telemetry too (vdot, x1 finite => u, x2 finite): never NaN or Inf
         keep = ok & result_ok
         u = tuple(np.where(keep, c, zero) for c in u)
         vdot = tuple(np.where(keep, c, zero) for c in vdot)
