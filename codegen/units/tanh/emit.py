@@ -128,6 +128,23 @@ def pow_initializer(t: PowTab, indent: str = "    ") -> str:
             + rows + "\n" + indent + "},\n" + indent + "{\n" + indent * 2 + ek + "\n" + indent + "}\n}")
 
 
+def log_initializer(indent: str = "    ") -> str:
+    """C initializer of <name>_log_t: 0x1.99999ap-3, 0x1.555556p-2, sg_logf_tab_rows {c, 1/c, ln c, 0},
+    k * 0x1.62e4p-1 and k * 0x1.7f7d1cp-20 (float32 products) for k = E - 127, E = 0 .. 127."""
+    rows = np.asarray(detmath._LT_ROWS, dtype=np.float32)  # sg_logf_tab_rows (float32 values)
+    assert np.array_equal(rows.astype(np.float64), detmath._LT_ROWS)
+    k = (np.arange(128) - 127).astype(np.float32)
+    kh = (k * np.float32(float.fromhex("0x1.62e4p-1"))).astype(np.float32)
+    kl = (k * np.float32(float.fromhex("0x1.7f7d1cp-20"))).astype(np.float32)
+    body = (",\n" + indent * 2).join("{" + ", ".join(c_float(v) for v in (*r, np.float32(0.0))) + "}" for r in rows)
+    def flat(a):
+        return (",\n" + indent * 2).join(", ".join(c_float(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
+    return ("{\n" + indent + c_float(np.float32(float.fromhex("0x1.99999ap-3"))) + ",\n" + indent
+            + c_float(np.float32(float.fromhex("0x1.555556p-2"))) + ",\n" + indent + "{\n" + indent * 2 + body + "\n"
+            + indent + "},\n" + indent + "{\n" + indent * 2 + flat(kh) + "\n" + indent + "},\n" + indent + "{\n"
+            + indent * 2 + flat(kl) + "\n" + indent + "}\n}")
+
+
 def template_context(p: TanhParams, period: float, name: str) -> dict:
     c = constants32(p, period)
     if not c.eta >= np.finfo(np.float32).tiny:
@@ -155,6 +172,7 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "pow_f": pow_f, "pow_u": pow_u,
         "pow_f_init": pow_initializer(pow_f), "pow_u_init": pow_initializer(pow_u),
         "eta_bits": f"0x{int(c.eta.view(np.uint32)):08x}",
+        "log_init": log_initializer(),
         "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
         "tanh_half": TANH_HALF, "tanh_cols": TANH_COLS,
     }
