@@ -60,10 +60,9 @@ def e_solve(q0, inv_q0, kk, e, v):
 def pow_scaled(x, t: PowTab):
     """K x^y from the bits of x (sign included) by powtab's tables, as the C's <name>_pow_*3."""
     u = x.view(np.uint32)
-    i = u + np.uint32(powtab.BIAS)
-    row = t.rows[((i >> np.uint32(t.shift)) & np.uint32(t.n - 1)).astype(np.intp)]
-    z = ((i & np.uint32(0x007FFFFF)) + np.uint32(powtab.Z0)).view(F32)
-    ek = t.ek[(i >> np.uint32(23)).astype(np.intp)]
+    row = t.rows[((u >> np.uint32(t.shift)) & np.uint32(t.n - 1)).astype(np.intp)]
+    z = ((u & np.uint32(0x007FFFFF)) | np.uint32(powtab.Z0)).view(F32)
+    ek = t.ek[(u >> np.uint32(23)).astype(np.intp)]
     r = f32((z - row[..., 0]) * row[..., 1], "pow r")
     q = r * (t.p1 * r + t.p0)
     s = row[..., 2] * ek

@@ -3,20 +3,19 @@
 The C (templates/tanh.c.j2, `<name>_powK*`) and the golden twin (golden.pow_scaled) evaluate, for
 the bits u of a float32 x (the sign bit included):
 
-    i = u + 0x004d0000              (z in [0x1.66p-1, 0x1.66p+0): x = ±2^(E - 127) z, E = (i >> 23) & 255)
-    row = rows[(i >> SHIFT) & (N - 1)] = {c, 1/c, c^y, 0}     (N intervals of z, c their midpoints)
-    z = bits((i & 0x7fffff) + 0x3f330000)
+    x = ±2^(E - 127) z, z in [1, 2), E = (u >> 23) & 255 (the biased exponent)
+    row = rows[(u >> SHIFT) & (N - 1)] = {c, 1/c, c^y, 0}   (N intervals of z, c their midpoints)
+    z = bits((u & 0x7fffff) | 0x3f800000)
     r = (z - c) (exact, Sterbenz) * (1/c)                   |r| <= 2^-8 for N = 128, 2^-9 for 256
     q = r (p0 + r p1)               p0 = y, p1 = y (y - 1) / 2: (1 + r)^y - 1 to the quadratic term
-    s = c^y * ek[i >> 23]           ek[E] = K 2^(y (E - 127)), ek[256 + E] = -ek[E] (the sign of x), ek[0] = 0
+    s = c^y * ek[u >> 23]           ek[E] = K 2^(y (E - 127)), ek[256 + E] = -ek[E] (the sign of x), ek[0] = 0
     result = s + s q                = sign(x) K |x|^y
 
 sg_powf_const (sg_math.h) has 32 intervals and a cubic; here N is 128 or 256 (the smallest whose
 truncation |y (y - 1) (y - 2) / 6| r^3 stays below 2^-27) and the scale K and the sign of x are in
 the 2^(y k) table, so there is no multiply by K, no sign select and no range test: every u gives
-a finite value (ek[0] = 0: x = ±0 and subnormals below 0x00330000 give ±0; the other subnormals a
-value below K 2^(-126 y), as the true power; NaN and Inf a finite value nobody reads, see the
-template). Error <= 2.5 ulp of K|x|^y for normal x (tests/codegen/units/tanh).
+a finite value (ek[0] = ±0: x = ±0 and subnormals give ±0, sg_powf_const's +0 there; NaN and Inf
+a finite value nobody reads, see the template). Error <= 2.5 ulp of K|x|^y for normal x (tests/codegen/units/tanh).
 
 Every table entry is the float64 (Decimal, 40 digits: byte-identical on every host) value rounded
 once to float32.
@@ -31,8 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 F32 = np.float32
-BIAS = 0x004D0000          # 0x3f800000 - 0x3f330000
-Z0 = 0x3F330000            # bits of the smallest z
+Z0 = 0x3F800000            # bits of the smallest z (1.0)
 TRUNCATION_MAX = 2.0 ** -27
 
 
