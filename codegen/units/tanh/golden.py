@@ -155,11 +155,11 @@ def fallback(k: Constants32, e, w_e):
 
 
 def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
-    """(u, vdot, x1, x2, status, inputs_ok) as {name}_law; inputs_ok: R_e, w_e and wdot_t finite."""
+    """(u, vdot, x1, x2, status, inputs_ok) as {name}_law; inputs_ok: w_e and wdot_t (and so R_e) finite."""
     re = error_matrix(rt, rc)
     rw = mat_t_vec(re, w_t)
     w_e = v_sub(w_c, rw)
-    inputs_ok = sum_is_finite(re + w_e + wdot_t)
+    inputs_ok = sum_is_finite(w_e + wdot_t)  # every entry of R_e is in a product of w_e
     tr = (re[0] + re[4]) + re[8]
     opt = F32(1.0) + tr
     upper = opt > k.q0min_sq4
