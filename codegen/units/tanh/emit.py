@@ -110,6 +110,11 @@ def sqrt_gt_threshold(n1: np.float32) -> np.float32:
     return np.float32(d)
 
 
+def equal_gains(c: Constants32) -> bool:
+    """k1 = k2 = k3 (as float32): the torque (17) is then -k1 ((tanh a + tanh b) + tanh c)."""
+    return bool(c.k2 == c.k3 and c.nk1 == -c.k2)
+
+
 def shaping_pow(c: Constants32) -> PowTab:
     """beta2 |x|^(gamma - 1) of f (11) (gamma - 1 the float32 constant)."""
     return pow_tables(c.gamma_m1, c.beta2)
@@ -171,7 +176,7 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
         "pow_f": pow_f, "pow_u": pow_u,
         "pow_f_init": pow_initializer(pow_f), "pow_u_init": pow_initializer(pow_u),
-        "eta_bits": f"0x{int(c.eta.view(np.uint32)):08x}",
+        "eta_bits": f"0x{int(c.eta.view(np.uint32)):08x}", "equal_gains": equal_gains(c),
         "log_init": log_initializer(),
         "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
         "tanh_half": TANH_HALF, "tanh_cols": TANH_COLS,

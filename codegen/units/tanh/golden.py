@@ -23,7 +23,7 @@ from codegen import detmath
 from codegen.golden_vec3 import f32, v3, v_cross, v_dot, v_sub
 from codegen.units.tanh import powtab
 from codegen.units.tanh.emit import (INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, Constants32, compensation_pow,
-                                     shaping_pow)
+                                     equal_gains, shaping_pow)
 from codegen.units.tanh.powtab import PowTab
 
 F32 = np.float32
@@ -117,8 +117,12 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     dg = v3(*((c1 - fs[i][1]) * x1_dot[i] + radial * x1[i] for i in range(3)))
     dg = v_sub(dg, e_dot_w)
     w_ev_dot = e_solve(q0, inv_q0, kk, x1, dg)
-    u = v3(*((k.nk1 * detmath.tanhf(k.eps1 * varpi[i]) - k.k2 * detmath.tanhf(k.eps2 * x1[i]))
-             - k.k3 * detmath.tanhf(k.eps3 * x1_dot[i]) for i in range(3)))
+    ta, tb, tc = ([detmath.tanhf(eps * v[i]) for i in range(3)]
+                  for eps, v in ((k.eps1, varpi), (k.eps2, x1), (k.eps3, x1_dot)))
+    if equal_gains(k):  # -k1 ((tanh a + tanh b) + tanh c)
+        u = v3(*(k.nk1 * ((ta[i] + tb[i]) + tc[i]) for i in range(3)))
+    else:
+        u = v3(*((k.nk1 * ta[i] - k.k2 * tb[i]) - k.k3 * tc[i] for i in range(3)))
     a = force_terms(k, re, w_c, w_e, wdot_t, w_ev_dot, u)
     delta = v_sub(x2, varpi)
     dsq = v_dot(delta, delta)
