@@ -97,11 +97,12 @@ def compensation(k: Constants32, delta, dsq):
     return v3(*(np.where(outer, kk * delta[i], pow_scaled(delta[i], compensation_pow(k))) for i in range(3)))
 
 
-def nominal(k: Constants32, varpi, re, q0, k_e, x1, om, w_c, w_e, wdot_t):
+def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     """(u, vdot, x2) of law (10)-(20), as {name}_nominal."""
     inv_q0 = F32(4.0) * k_e
-    kk = F32(2.0)  # unit quaternion (q0, x1): 2/(q0² + |x1|²) = 2 and 1/(1 − |x1|²) = 1/q0²
-    inv_om = inv_q0 * inv_q0
+    m = q0 * q0 + nsq  # 1 + O(1e-7): (q0, x1) is a unit quaternion up to rounding
+    kk = F32(2.0) * (F32(2.0) - m)  # 2/m to (1 - m)²
+    inv_om = inv_q0 * inv_q0  # 1/(1 − |x1|²) = 1/q0²
     barrier = k.lam * detmath.logf_tab(om)
     fs = [shaping(k, x1[i]) for i in range(3)]
     c1 = k.nbeta1 + barrier
@@ -171,7 +172,7 @@ def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
     nsq = v_dot(x1, x1)
     om = np.where(upper, F32(1.0) - nsq, F32(0.0))
     regular = om > k.q0min_sq
-    u_n, vdot_n, x2_n = nominal(k, varpi, re, F32(0.5) * s, k_e, x1, om, w_c, w_e, wdot_t)
+    u_n, vdot_n, x2_n = nominal(k, varpi, re, F32(0.5) * s, k_e, x1, nsq, om, w_c, w_e, wdot_t)
     e_s = error_near_180(re, tr)
     u_s = fallback(k, e_s, w_e)
     zero = np.zeros_like(tr)
