@@ -87,7 +87,7 @@ def force_terms(k: Constants32, re, w_c, w_e, wdot_t, w_ev_dot, u):
     inner = v_cross(w_c, w_e)
     feed = mat_t_vec(re, wdot_t)
     j_sum = mat_vec(J, v3(*((inner[i] + feed[i]) + w_ev_dot[i] for i in range(3))))
-    return v3(*((-gyro[i] - j_sum[i]) + u[i] for i in range(3)))
+    return v3(*(u[i] - (gyro[i] + j_sum[i]) for i in range(3)))  # = (-gyro - j_sum) + u exactly
 
 
 def compensation(k: Constants32, delta, dsq):
