@@ -125,8 +125,8 @@ def nominal(k: Constants32, varpi, re, q0, k_e, x1, nsq, om, w_c, w_e, wdot_t):
     a = force_terms(k, re, w_c, w_e, wdot_t, w_ev_dot, u)
     delta = v_sub(x2, varpi)
     dsq = v_dot(delta, delta)
-    inv_sq = F32(1.0) / np.where(dsq <= k.delta_reg, dsq + k.delta_reg, dsq)
-    along = ((((v_dot(x2, a) + v_dot(x1, x1_dot)) + k.k5) + k.d_max * detmath.sqrtf(v_dot(x2, x2))) * inv_sq) + k.k4
+    rho_den = np.where(dsq <= k.delta_reg, dsq + k.delta_reg, dsq)
+    along = ((((v_dot(x2, a) + v_dot(x1, x1_dot)) + k.k5) + k.d_max * detmath.sqrtf(v_dot(x2, x2))) / rho_den) + k.k4
     j_inv_a = mat_vec(tuple(k.J_inv), a)
     ua = compensation(k, delta, dsq)
     vdot = v3(*((j_inv_a[i] + along * delta[i]) + ua[i] for i in range(3)))
