@@ -162,7 +162,9 @@ def law(k: Constants32, varpi, rc, w_c, rt, w_t, wdot_t):
     re = error_matrix(rt, rc)
     rw = mat_t_vec(re, w_t)
     w_e = v_sub(w_c, rw)
-    inputs_ok = sum_is_finite(w_e + wdot_t)  # every entry of R_e is in a product of w_e
+    # every entry of R_e is in a product of w_e; the C sums the six as a tree
+    tree = f32(f32(f32(w_e[0] + w_e[1]) + f32(w_e[2] + wdot_t[0])) + f32(wdot_t[1] + wdot_t[2]), "sum")
+    inputs_ok = (tree - tree) == F32(0.0)
     tr = (re[0] + re[4]) + re[8]
     opt = F32(1.0) + tr
     upper = opt > k.q0min_sq4
