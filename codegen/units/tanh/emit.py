@@ -125,10 +125,11 @@ def compensation_pow(c: Constants32) -> PowTab:
     return pow_tables(c.gamma, c.ua_inner)
 
 
-def pow_initializer(t: PowTab, indent: str = "    ") -> str:
-    """C initializer of a <name>_pow_*_t: {p0, p1}, the rows {c, 1/c, c^y, 0}, ek (8 per line)."""
+def pow_initializer(t: PowTab, indent: str = "    ", n_ek: int = 512) -> str:
+    """C initializer of a <name>_pow_*_t: {p0, p1}, the rows {c, 1/c, c^y, 0}, the first n_ek entries of
+    ek (8 per line; 256 where x >= 0)."""
     rows = (",\n" + indent * 2).join("{" + ", ".join(c_float(v) for v in r) + "}" for r in t.rows)
-    ek = (",\n" + indent * 2).join(", ".join(c_float(v) for v in t.ek[i:i + 8]) for i in range(0, len(t.ek), 8))
+    ek = (",\n" + indent * 2).join(", ".join(c_float(v) for v in t.ek[i:i + 8]) for i in range(0, n_ek, 8))
     return ("{\n" + indent + "{" + c_float(t.p0) + ", " + c_float(t.p1) + "},\n" + indent + "{\n" + indent * 2
             + rows + "\n" + indent + "},\n" + indent + "{\n" + indent * 2 + ek + "\n" + indent + "}\n}")
 
@@ -175,7 +176,7 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
         "limit_text": _text(p.varpi_limit), "q0_min_text": _text(p.q0_min),
         "torque_bound_text": _text(p.k1 + p.k2 + p.k3), "params_lines": params_lines,
         "pow_f": pow_f, "pow_u": pow_u,
-        "pow_f_init": pow_initializer(pow_f), "pow_u_init": pow_initializer(pow_u),
+        "pow_f_init": pow_initializer(pow_f, n_ek=256), "pow_u_init": pow_initializer(pow_u),
         "eta_bits": f"0x{int(c.eta.view(np.uint32)):08x}", "equal_gains": equal_gains(c),
         "log_init": log_initializer(),
         "tanh_rows": [[c_float(v) for v in row] for row in tanh_rows()],
