@@ -3,11 +3,15 @@
 Operation for operation and in the same order as the C, vectorised across N independent
 states: a 3-vector is a tuple of three (N,) float32 arrays, R_e nine of them; every C branch
 is a mask (np.where), both sides computed, the taken one kept. Sums are written out left to
-right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin): tanhf,
-logf_tab, sqrtf, powf_const; |x|^γ = |x|·powf_const(|x|, γ−1) in f (11), powf_const(|x|, γ) in
-u_a (20) (+0 where |δ_i| is not a positive normal float: the C has no slow path there), as in the
-C. The C's tanh, powers and log are its own inline copies of sg_math's table paths (the same
-operations in the same order), so detmath's functions are their twins. Constants are the float32 values of codegen.tanh_emit.constants32, the
+right (never @, dot or sum), transcendentals are codegen.detmath (sg_math's twin) for tanhf,
+logf_tab and sqrtf (the C's tanh and log are its own inline copies of sg_math's table paths, the
+same operations in the same order, the tanh from a table with the sign folded in whose every
+intermediate is sg_tanhf's or its exact negation) and pow_scaled below for the powers: the C's own
+tables (codegen/units/tanh/powtab.py, K x^y from 128/256 intervals and a quadratic, ≤ 2.5 ulp):
+β2|x|^(γ−1) in f (11) (β2 f = x·q, β2 f' = γ·q), ||J⁻¹|| d_max sig(δ)^γ / n1^γ in u_a (20) (±0 for
+δ_i = ±0 or subnormal). E⁻¹ is the unit quaternion's (2/m as 2(2 − m), 1/(1 − |x1|²) as 1/q0²),
+the torque -k1 ((tanh a + tanh b) + tanh c) when k1 = k2 = k3, the validity sums trees of w_e, ω̇_t
+(inputs) and ϖ̇, x1 (outputs): docs/tanh-controller.md, "Generated C". Constants are the float32 values of codegen.tanh_emit.constants32, the
 same ones the C carries as hex floats. Every stage asserts float32 (numpy 2 promotes float32
 with a float64 scalar).
 
