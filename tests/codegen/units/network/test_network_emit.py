@@ -17,6 +17,8 @@ from codegen.units.network.unit import NetworkUnit
 from firmware import flags, x86
 from firmware.errors import FirmwareError
 from tools.cycles import profile_entry
+from tools.m4.elf import Image
+from tools.m4.wcet import Analysis
 from tools.runners import LAYOUT_FILE, X86Runner, arm_build, pack
 
 LIBM = {"tanhf", "tanh", "expf", "exp", "logf", "log", "sinf", "sin", "cosf", "cos", "atan2f", "atan2",
@@ -206,8 +208,6 @@ def test_network_path_worst_case_cycles_within_budget():
     """Cycle model, ideal mode: the static bound of network_eval, and the 50 vectors of each input
     class (inside, edges, outside, special values: saturated and non-finite rows take the tanh
     pair's slow paths, inline) under it."""
-    from tools.m4.elf import Image
-    from tools.m4.wcet import Analysis
     a = art.random_artifact((12, 40, 3), seed=1)
     unit = NetworkUnit(a)
     classes = unit.cycle_classes(50, 0)

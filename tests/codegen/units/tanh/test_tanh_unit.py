@@ -17,6 +17,7 @@ from codegen.units.tanh import emit as tanh_emit
 from codegen.units.tanh import golden as gt
 from codegen.units.tanh.emit import INPUT_DTYPE, STATE_DTYPE
 from codegen.units.tanh.params import TanhParamsError, load_params
+from codegen.units.tanh.powtab import pow_tables
 from codegen.units.tanh.unit import TanhUnit
 from host.sim import tanh_example as ex
 from host.control import tanh_law
@@ -252,7 +253,6 @@ def test_n1_dsq_threshold_matches_the_sqrt_branch(n1):
 def test_power_tables_are_within_2_5_ulp():
     """powtab's K x^y (the C's <name>_pow_*3, twin golden.pow_scaled) against float64: ≤ 2.5 ulp for
     normal x of both signs over the whole range, ±0 for ±0 and subnormal x, finite for Inf/NaN."""
-    from codegen.units.tanh.powtab import pow_tables
     rng = np.random.default_rng(11)
     for y, scale in ((float(K.gamma_m1), float(K.beta2)), (float(K.gamma), float(K.ua_inner)), (-0.95, 1.0),
                      (0.05, 1.0), (0.95, 0.5)):
