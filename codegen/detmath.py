@@ -87,6 +87,33 @@ def _load_tanh_table() -> np.ndarray:
 
 _TANH_TAB = _load_tanh_table()
 TANH_TABLE = _TANH_TAB   # sg_tanh_tab as laid out in flash (the integrity CRC covers it)
+
+
+# The signed tanh table (network.c's <name>_tanh_rows, tanh.c's torque tanh): sg_tanh_tab with the
+# sign of the argument folded in, for sg_tanhf's bits without |x| and without a final negation.
+# Each half has TANH_HALF rows of TANH_COLS floats (a power of two: a row's address is one shift
+# and add): sg_tanh_tab's 121 intervals, then rows that
+# give exactly 1 for 9 <= |x| < 16 (c0 = 1, the rest 0), so that one compare of the two indices of a
+# pair, OR-ed, tells whether both are in the table. For x < 0 the row of interval i is mirrored
+# below the middle (row TANH_HALF - 1 - i) with the signs below: t = x + c = -(|x| - c) and a Horner
+# chain whose every intermediate is sg_tanhf's or its exact negation, so -sg_tanhf(|x|) bit for bit.
+TANH_HALF = 128
+TANH_COLS = 8
+TANH_MIRROR_SIGNS = np.array([-1, -1, 1, -1, 1, -1], dtype=np.float32)
+
+
+def tanh_rows() -> np.ndarray:
+    """The signed tanh table, (2 * TANH_HALF, TANH_COLS) float32: for x < 0 the mirrored rows (interval
+    TANH_HALF - 1 first), then for x >= 0 sg_tanh_tab's rows, padded with zero columns."""
+    tab = TANH_TABLE
+    pos = np.zeros((TANH_HALF, TANH_COLS), dtype=np.float32)
+    pos[:tab.shape[0], :6] = tab
+    pos[tab.shape[0]:, 1] = 1.0  # tanh is 1 to float32 precision from 9 on (sg_tanhf's rule)
+    neg = pos.copy()
+    neg[:, :6] *= TANH_MIRROR_SIGNS
+    return np.concatenate([neg[::-1], pos]).astype(np.float32)
+
+
 _TANH_COLS = tuple(np.ascontiguousarray(_TANH_TAB[:, j]) for j in range(6))  # fast 1-D take
 
 

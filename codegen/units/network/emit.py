@@ -11,7 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from codegen import GENERATOR_VERSION, detmath
+from codegen import GENERATOR_VERSION
+from codegen.detmath import TANH_COLS, TANH_HALF, tanh_rows
 from codegen.artifact import Artifact
 from codegen.cgen import c_float, check_name, comment, environment, math_sources, write_sources
 from codegen.units.network.fold import Folded, fold
@@ -57,30 +58,6 @@ def load_groups(n_in: int) -> list[list[int]]:
     groups of at most LOAD_GROUP that the C loads back to back before summing them."""
     order = list(range(n_in + 1))
     return [order[k:k + LOAD_GROUP] for k in range(0, len(order), LOAD_GROUP)]
-
-
-# <name>_tanh_rows (network.c): sg_tanh_tab with the sign of the argument folded in, for tansig
-# without |x| and without a final negation. Each half has TANH_HALF rows of TANH_COLS floats (a
-# power of two: a row's address is one shift and add): sg_tanh_tab's 121 intervals, then rows that
-# give exactly 1 for 9 <= |x| < 16 (c0 = 1, the rest 0), so that one compare of the two indices of a
-# pair, OR-ed, tells whether both are in the table. For x < 0 the row of interval i is mirrored
-# below the middle (row TANH_HALF - 1 - i) with the signs below: t = x + c = -(|x| - c) and a Horner
-# chain whose every intermediate is sg_tanhf's or its exact negation, so -sg_tanhf(|x|) bit for bit.
-TANH_HALF = 128
-TANH_COLS = 8
-TANH_MIRROR_SIGNS = np.array([-1, -1, 1, -1, 1, -1], dtype=np.float32)
-
-
-def tanh_rows() -> np.ndarray:
-    """<name>_tanh_rows, (2 * TANH_HALF, TANH_COLS) float32: for x < 0 the mirrored rows (interval
-    TANH_HALF - 1 first), then for x >= 0 sg_tanh_tab's rows, padded with zero columns."""
-    tab = detmath.TANH_TABLE
-    pos = np.zeros((TANH_HALF, TANH_COLS), dtype=np.float32)
-    pos[:tab.shape[0], :6] = tab
-    pos[tab.shape[0]:, 1] = 1.0  # tanh is 1 to float32 precision from 9 on (sg_tanhf's rule)
-    neg = pos.copy()
-    neg[:, :6] *= TANH_MIRROR_SIGNS
-    return np.concatenate([neg[::-1], pos]).astype(np.float32)
 
 
 # FPU registers the input stage may use without saving any (s0-s15, AAPCS caller-saved).

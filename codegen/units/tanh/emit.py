@@ -21,7 +21,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION, detmath
 from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 from codegen.errors import CodegenError
-from codegen.units.network.emit import TANH_COLS, TANH_HALF, tanh_rows
+from codegen.detmath import TANH_COLS, TANH_HALF, tanh_rows
 from codegen.units.tanh.powtab import PowTab, pow_tables
 from codegen.units.tanh.params import TanhParams, derived_constants
 

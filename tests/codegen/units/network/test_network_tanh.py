@@ -27,11 +27,11 @@ def _index(u: np.ndarray) -> np.ndarray:
 
 def _table_tanh(x: np.ndarray) -> np.ndarray:
     """The C's formula: row middle + (i ^ sign mask), t = x - row[0], the Horner chain in its order."""
-    rows = emit.tanh_rows()
+    rows = detmath.tanh_rows()
     u = x.view(U32)
     i = _index(u)
-    assert (i < emit.TANH_HALF).all()
-    k = (i ^ (U32(0) - (u >> U32(31)))).view(np.int32).astype(np.int64) + emit.TANH_HALF
+    assert (i < detmath.TANH_HALF).all()
+    k = (i ^ (U32(0) - (u >> U32(31)))).view(np.int32).astype(np.int64) + detmath.TANH_HALF
     r = rows[k]
     t = x - r[:, 0]
     p = r[:, 5] * t
@@ -45,13 +45,13 @@ def _table_tanh(x: np.ndarray) -> np.ndarray:
 
 
 def test_tanh_rows_layout():
-    rows = emit.tanh_rows()
+    rows = detmath.tanh_rows()
     n = detmath.TANH_TABLE.shape[0]
-    half = emit.TANH_HALF
-    assert rows.shape == (2 * half, emit.TANH_COLS) and rows.dtype == F32
+    half = detmath.TANH_HALF
+    assert rows.shape == (2 * half, detmath.TANH_COLS) and rows.dtype == F32
     pos, neg = rows[half:], rows[:half][::-1]
     assert np.array_equal(pos[:n, :6], detmath.TANH_TABLE)  # sg_tanh_tab itself for x >= 0
-    assert np.array_equal(neg[:, :6], pos[:, :6] * emit.TANH_MIRROR_SIGNS)
+    assert np.array_equal(neg[:, :6], pos[:, :6] * detmath.TANH_MIRROR_SIGNS)
     assert (pos[n:, 1] == 1).all() and not pos[n:, [0, 2, 3, 4, 5]].any()  # 9 <= |x| < 16: exactly 1
     assert not rows[:, 6:].any()
 
@@ -168,7 +168,7 @@ def test_c_tanh_pair_is_sg_tanhf_bit_for_bit_for_every_pair_of_classes(clib):
     _tanh, pair, sg = clib
     rng = np.random.default_rng(4)
     x = _arguments(rng)
-    inside = (_index(x.view(U32)) < emit.TANH_HALF)
+    inside = (_index(x.view(U32)) < detmath.TANH_HALF)
     ins, outs = x[inside], x[~inside]
     assert ins.size > 1000 and outs.size > 1000
     for a_pool, b_pool in ((ins, ins), (ins, outs), (outs, ins), (outs, outs), (x, x)):
