@@ -67,7 +67,8 @@ def range_ratio(xmin, xmax) -> np.ndarray:
 
 
 def _f32(values, what: str) -> np.ndarray:
-    out = np.asarray(values, dtype=np.float64).astype(np.float32)
+    with np.errstate(over="ignore"):  # an overflow is reported below, as one line
+        out = np.asarray(values, dtype=np.float64).astype(np.float32)
     if not np.all(np.isfinite(out)):
         raise CodegenError(f"folding mapminmax into the layers: {what} is not finite in float32")
     return out

@@ -1,8 +1,10 @@
 """C emitter: deterministic output, exact constants and layout, C99/flags clean on both targets,
 no libm / malloc / mutable globals in the objects, and the M4 inner loop without spills."""
+import dataclasses
 import re
 import shutil
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -80,6 +82,20 @@ def test_constants_are_exact_and_in_consumption_order(artifact, sources):
     assert not re.search(r"static const float network_\w*(gain|ymin)", c)  # mapminmax is in the layers
     code = re.sub(r"/\*.*?\*/", "", c, flags=re.S)
     assert not re.search(r"[\w)\]] / [\w(]", code)  # no division left
+
+
+def test_a_fold_that_overflows_float32_is_a_one_line_error():
+    """A weight the artifact allows (finite float32) times a large input gain (MATLAB allows up to
+    1e14) can leave float32: generation stops with one line naming the product, no warning."""
+    a = art.random_artifact((12, 40, 3), seed=1)
+    W1 = np.array(a.W1, dtype=np.float32)
+    W1[0, 0] = 1e30
+    bad = dataclasses.replace(a, W1=W1, input_map=art.mapminmax_settings(np.zeros(12), np.r_[1e-13, np.ones(11)]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(CodegenError, match="W1 \\* in_gain is not finite in float32") as err:
+            fold.fold(bad)
+    assert "\n" not in str(err.value)
 
 
 def test_folded_layers_are_mapminmax_moved_into_the_weights():
