@@ -21,7 +21,9 @@ def _num(x: float) -> str:
 
 def field_docs(p: TanhParams) -> dict[str, list[FieldDoc]]:
     bound, vlim = _num(p.k1 + p.k2 + p.k3), _num(p.varpi_limit)
-    matrix = f"entries in [-1, 1] for a rotation matrix; any finite matrix is used as given (not re-orthonormalised); {INVALID}"
+    matrix = (f"entries in [-1, 1] for a rotation matrix; any finite matrix is used as given (not re-orthonormalised; "
+              f"E^-1 assumes a unit error quaternion, so far from SO(3) torque and varpi depart, finitely, from the "
+              f"float64 law); {INVALID}")
     return {
         "input": [
             FieldDoc("R_c", "-", "body -> reference", matrix, f"body attitude ({DCM})"),
