@@ -74,9 +74,10 @@ def test_sil_and_pil_fly_the_same_trajectory(sil, pil):
 def test_pil_reports_cycles_per_step(pil):
     cycles = pil["history"]["cycles"]
     assert cycles.shape == (401,) and pil["cycles_min"] > 1000
-    # the example's own steps, strict table: measured up to 1,189 ideal (1,443 before the second round
-    # of cycle work of docs/tanh-controller.md, "Cycles"); SPEC 8's budget
-    assert pil["cycles_max"] <= 1_200
+    # the example's own steps, strict table: measured up to 1,177 ideal (1,189 before the third round,
+    # 1,443 before the second round of cycle work of docs/tanh-controller.md, "Cycles"); SPEC 8's
+    # budget is 1,200, the guard is the measured value so that a regression shows
+    assert pil["cycles_max"] <= 1_177
 
 
 def test_cycle_report_of_tanh_step():
@@ -85,12 +86,15 @@ def test_cycle_report_of_tanh_step():
     rep = cycle_report(unit, ("ideal",), per_class=250, seed=0)
     assert set(rep["by_class"]) == {"random", "small", "delta", "singular", "off_so3", "extreme", "special",
                                     "example"}
-    # SPEC 8 (strict, ideal, <= 1,200 on the larger of bound and sampled max). Measured: sampled 1,197,
-    # static bound 1,200 (strict; 1,162 / 1,167 lenient)
-    assert rep["cycles_lenient"]["ideal"]["max"] <= 1_200 and unit.budgets.cycles == 1_200
-    assert rep["cycles"]["ideal"]["max"] <= rep["bound"]["strict"]["ideal"] <= 1_200
+    # SPEC 8 (strict, ideal, <= 1,200 on the larger of bound and sampled max). Measured: sampled 1,177,
+    # static bound 1,177 (strict; 1,159 / 1,159 lenient); 1,197 / 1,200 before the third round of cycle
+    # work (docs/tanh-controller.md, "Cycles"). The guards are the measured values, 23 cycles of margin
+    # against the budget: a change that gives some of it back fails here first
+    assert rep["cycles_lenient"]["ideal"]["max"] <= 1_159 and unit.budgets.cycles == 1_200
+    assert rep["cycles"]["ideal"]["max"] <= rep["bound"]["strict"]["ideal"] <= 1_177
+    assert rep["bound"]["lenient"]["ideal"] <= 1_159
     assert rep["stack_bytes"] is not None and rep["stack_painted"] <= rep["stack_bytes"] <= 512
-    # 26,508 B measured, of which the signed tanh rows (8,192 B), the two power tables (3,080 and
+    # 26,528 B measured, of which the signed tanh rows (8,192 B), the two power tables (3,080 and
     # 4,104 B) and the log's (1,544 B); the constant tables run from CCM (copied at start-up), so
     # they count in RAM too, those four at least
     tables = 8_192 + 3_080 + 4_104 + 1_544
