@@ -498,11 +498,12 @@ class PowC(NamedTuple):
     ek: np.ndarray  # (255,) 2^(y k), k = -126 .. 128
 
 
-def _decimal_pow(base: float, exponent: float):
-    """base**exponent for base > 0 from the exact binary values, to 40 significant digits."""
+def decimal_pow(base: float, exponent: float, scale: float = 1.0) -> decimal.Decimal:
+    """scale * base**exponent for base > 0 from the exact binary values, to 40 significant digits
+    (byte-identical table entries on every host)."""
     with decimal.localcontext() as ctx:
         ctx.prec = 40
-        return (decimal.Decimal(exponent) * decimal.Decimal(base).ln()).exp()
+        return decimal.Decimal(scale) * (decimal.Decimal(exponent) * decimal.Decimal(base).ln()).exp()
 
 
 @functools.lru_cache(maxsize=64)
@@ -514,10 +515,10 @@ def _powc_tables(ybits: int) -> PowC:
     p = (y, y * (y - 1.0) / 2.0, y * (y - 1.0) * (y - 2.0) / 6.0, y * (y - 1.0) * (y - 2.0) * (y - 3.0) / 24.0)
     # Decimal, not float `**`: the host's libm pow may differ between machines, and the generated
     # sources must be byte-identical everywhere (exact y, 40 digits, then rounded).
-    cy = np.array([float(_decimal_pow(float(c), y)) for c in _PT_LOG[:, 0]], dtype=F32)
+    cy = np.array([float(decimal_pow(float(c), y)) for c in _PT_LOG[:, 0]], dtype=F32)
     # |y| <= 31/32 keeps every entry (and result) normal; closer to 1 the ends are clamped to the
     # float32 range (deterministic, outside the asserted error bound)
-    ek = np.array([min(float(_decimal_pow(2.0, y * k)), float(np.finfo(F32).max)) for k in range(-126, 129)],
+    ek = np.array([min(float(decimal_pow(2.0, y * k)), float(np.finfo(F32).max)) for k in range(-126, 129)],
                   dtype=F32)
     return PowC(y32, tuple(F32(v) for v in p), cy, ek)
 
@@ -603,6 +604,12 @@ _LT_ROWS = np.array([
 LOGF_TAB_ULP = 3.0
 
 
+# sg_logf_tab's polynomial coefficients of r^4 and r^2 (sg_math.h), also in the tanh law's log table.
+LOGF_TAB_C4 = F32(float.fromhex("0x1.99999ap-3"))
+LOGF_TAB_C2 = F32(float.fromhex("0x1.555556p-2"))
+LN2_HI, LN2_LO = _LN2_HI, _LN2_LO   # ln 2 split as sg_logf_tab and sg_expf use it
+
+
 def logf_tab(x) -> np.ndarray:
     """Mirror of sg_logf_tab (sg_math.h): table-driven ln x for x positive normal; else logf(x)."""
     x = _f32(x)
@@ -614,9 +621,8 @@ def logf_tab(x) -> np.ndarray:
         row = _LT_ROWS[((ix >> U32(18)) & U32(31)).astype(np.intp)]
         z = _as_f32((ix & U32(0x007FFFFF)) + U32(0x3F330000))
         r = (z - row[..., 0]) * row[..., 1]
-        p = (((F32(float.fromhex("0x1.99999ap-3")) * r - F32(0.25)) * r + F32(float.fromhex("0x1.555556p-2"))) * r
-             - F32(0.5)) * r
+        p = (((LOGF_TAB_C4 * r - F32(0.25)) * r + LOGF_TAB_C2) * r - F32(0.5)) * r
         lz = row[..., 2] + r * (p + F32(1.0))
-        res = kf * F32(float.fromhex("0x1.62e4p-1")) + (kf * F32(float.fromhex("0x1.7f7d1cp-20")) + lz)
+        res = kf * LN2_HI + (kf * LN2_LO + lz)
         out = np.where(fast, res, logf(x))
     return _check(np.asarray(out, dtype=F32))

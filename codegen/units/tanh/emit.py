@@ -125,30 +125,33 @@ def compensation_pow(c: Constants32) -> PowTab:
     return pow_tables(c.gamma, c.ua_inner)
 
 
+def _rows_of_8(values, indent: str) -> str:
+    """Float32 values as hex-float C literals, 8 per line."""
+    return (",\n" + indent * 2).join(", ".join(c_float(v) for v in values[i:i + 8]) for i in range(0, len(values), 8))
+
+
 def pow_initializer(t: PowTab, indent: str = "    ", n_ek: int = 512) -> str:
     """C initializer of a <name>_pow_*_t: {p0, p1}, the rows {c, 1/c, c^y, 0}, the first n_ek entries of
     ek (8 per line; 256 where x >= 0)."""
     rows = (",\n" + indent * 2).join("{" + ", ".join(c_float(v) for v in r) + "}" for r in t.rows)
-    ek = (",\n" + indent * 2).join(", ".join(c_float(v) for v in t.ek[i:i + 8]) for i in range(0, n_ek, 8))
+    ek = _rows_of_8(t.ek[:n_ek], indent)
     return ("{\n" + indent + "{" + c_float(t.p0) + ", " + c_float(t.p1) + "},\n" + indent + "{\n" + indent * 2
             + rows + "\n" + indent + "},\n" + indent + "{\n" + indent * 2 + ek + "\n" + indent + "}\n}")
 
 
 def log_initializer(indent: str = "    ") -> str:
-    """C initializer of <name>_log_t: 0x1.99999ap-3, 0x1.555556p-2, sg_logf_tab_rows {c, 1/c, ln c, 0},
-    k * 0x1.62e4p-1 and k * 0x1.7f7d1cp-20 (float32 products) for k = E - 127, E = 0 .. 127."""
+    """C initializer of <name>_log_t: sg_logf_tab's r^4 and r^2 coefficients, sg_logf_tab_rows
+    {c, 1/c, ln c, 0}, k * LN2_HI and k * LN2_LO (float32 products) for k = E - 127, E = 0 .. 127."""
     rows = np.asarray(detmath._LT_ROWS, dtype=np.float32)  # sg_logf_tab_rows (float32 values)
     assert np.array_equal(rows.astype(np.float64), detmath._LT_ROWS)
     k = (np.arange(128) - 127).astype(np.float32)
-    kh = (k * np.float32(float.fromhex("0x1.62e4p-1"))).astype(np.float32)
-    kl = (k * np.float32(float.fromhex("0x1.7f7d1cp-20"))).astype(np.float32)
+    kh = (k * detmath.LN2_HI).astype(np.float32)
+    kl = (k * detmath.LN2_LO).astype(np.float32)
     body = (",\n" + indent * 2).join("{" + ", ".join(c_float(v) for v in (*r, np.float32(0.0))) + "}" for r in rows)
-    def flat(a):
-        return (",\n" + indent * 2).join(", ".join(c_float(v) for v in a[i:i + 8]) for i in range(0, len(a), 8))
-    return ("{\n" + indent + c_float(np.float32(float.fromhex("0x1.99999ap-3"))) + ",\n" + indent
-            + c_float(np.float32(float.fromhex("0x1.555556p-2"))) + ",\n" + indent + "{\n" + indent * 2 + body + "\n"
-            + indent + "},\n" + indent + "{\n" + indent * 2 + flat(kh) + "\n" + indent + "},\n" + indent + "{\n"
-            + indent * 2 + flat(kl) + "\n" + indent + "}\n}")
+    return ("{\n" + indent + c_float(detmath.LOGF_TAB_C4) + ",\n" + indent
+            + c_float(detmath.LOGF_TAB_C2) + ",\n" + indent + "{\n" + indent * 2 + body + "\n"
+            + indent + "},\n" + indent + "{\n" + indent * 2 + _rows_of_8(kh, indent) + "\n" + indent + "},\n" + indent
+            + "{\n" + indent * 2 + _rows_of_8(kl, indent) + "\n" + indent + "}\n}")
 
 
 def template_context(p: TanhParams, period: float, name: str) -> dict:

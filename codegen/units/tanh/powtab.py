@@ -22,12 +22,13 @@ once to float32.
 """
 from __future__ import annotations
 
-import decimal
 import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from codegen.detmath import decimal_pow
 
 F32 = np.float32
 Z0 = 0x3F800000            # bits of the smallest z (1.0)
@@ -47,16 +48,6 @@ class PowTab:
     @property
     def n(self) -> int:
         return self.rows.shape[0]
-
-
-def _dec(v: float) -> decimal.Decimal:
-    return decimal.Decimal(v)
-
-
-def _pow(base: float, exponent: float, scale: float) -> float:
-    with decimal.localcontext() as ctx:
-        ctx.prec = 40
-        return float(_dec(scale) * (_dec(exponent) * _dec(base).ln()).exp())
 
 
 def intervals_for(y: float) -> int:
@@ -81,11 +72,11 @@ def _tables(ybits: int, kbits: int) -> PowTab:
         c = float(np.uint32(cbits).view(F32))
         rows[j, 0] = F32(c)
         rows[j, 1] = F32(1.0 / c)  # float64 division, rounded once (1/c is not exact)
-        rows[j, 2] = F32(_pow(c, y, 1.0))
+        rows[j, 2] = F32(float(decimal_pow(c, y)))
     ek = np.zeros(512, dtype=F32)
     top = float(np.finfo(F32).max)
     for e in range(1, 256):
-        v = F32(min(_pow(2.0, y * (e - 127), k), top))
+        v = F32(min(float(decimal_pow(2.0, y * (e - 127), k)), top))
         ek[e] = v
         ek[256 + e] = -v
     ek[256] = F32(-0.0)
