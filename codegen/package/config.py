@@ -86,13 +86,13 @@ def _is_real(v) -> bool:
 
 def _real(v, key: str) -> float:
     if not _is_real(v):
-        raise ConfigError(f"{key}: must be a number, got {_show(v)}")
+        raise ConfigError(f"{key}: must be a number, got {show_value(v)}")
     if not math.isfinite(v) or abs(v) > FLOAT32_MAX:
-        raise ConfigError(f"{key}: must be finite (and within float32), got {_show(v)}")
+        raise ConfigError(f"{key}: must be finite (and within float32), got {show_value(v)}")
     return float(v)
 
 
-def _show(v) -> str:
+def show_value(v) -> str:
     text = repr(v)
     return text if len(text) <= 40 else text[:37] + "..."
 
@@ -102,14 +102,14 @@ def _value(kind: str, v, key: str):
     if kind == "name":
         if not isinstance(v, str) or not NAME_PATTERN.fullmatch(v) or v.startswith("sg_"):
             raise ConfigError(f"{key}: must be a lower-case C identifier of at most 12 characters "
-                              f"(a-z, 0-9, _), not starting with 'sg_'; got {_show(v)}")
+                              f"(a-z, 0-9, _), not starting with 'sg_'; got {show_value(v)}")
         return v
     if kind == "units":
         if not isinstance(v, list) or not all(isinstance(u, str) for u in v):
-            raise ConfigError(f"{key}: must be a list of unit names, got {_show(v)}")
+            raise ConfigError(f"{key}: must be a list of unit names, got {show_value(v)}")
         for u in v:
             if u not in KNOWN_UNITS:
-                raise ConfigError(f"{key}: unknown unit {_show(u)} (known: {', '.join(KNOWN_UNITS)})")
+                raise ConfigError(f"{key}: unknown unit {show_value(u)} (known: {', '.join(KNOWN_UNITS)})")
         if len(set(v)) != len(v):
             raise ConfigError(f"{key}: lists a unit twice")
         if "controller" not in v:
@@ -117,13 +117,13 @@ def _value(kind: str, v, key: str):
         return tuple(u for u in KNOWN_UNITS if u in v)
     if kind == "int>=1":
         if not isinstance(v, int) or isinstance(v, bool):
-            raise ConfigError(f"{key}: must be an integer, got {_show(v)}")
+            raise ConfigError(f"{key}: must be an integer, got {show_value(v)}")
         if not 1 <= v <= MAX_DWELL:
             raise ConfigError(f"{key}: must be in [1, {MAX_DWELL}], got {v}")
         return v
     if kind == "vec3>=0":
         if not isinstance(v, list) or len(v) != 3:
-            raise ConfigError(f"{key}: must be a list of 3 numbers (x, y, z), got {_show(v)}")
+            raise ConfigError(f"{key}: must be a list of 3 numbers (x, y, z), got {show_value(v)}")
         out = tuple(_real(x, f"{key}[{i}]") for i, x in enumerate(v))
         for i, x in enumerate(out):
             if x < 0:
@@ -147,10 +147,10 @@ def _check(data) -> dict:
         if key not in TOP_KEYS:
             raise ConfigError(f"{key}: unknown key (known: {', '.join(TOP_KEYS)})")
     if data.get("format") != FORMAT:
-        raise ConfigError(f"format: must be \"{FORMAT}\", got {_show(data.get('format'))}")
+        raise ConfigError(f"format: must be \"{FORMAT}\", got {show_value(data.get('format'))}")
     version = data.get("version")
     if not isinstance(version, int) or isinstance(version, bool):
-        raise ConfigError(f"version: must be the integer {VERSION}, got {_show(version)}")
+        raise ConfigError(f"version: must be the integer {VERSION}, got {show_value(version)}")
     if version != VERSION:
         raise ConfigError(f"version: unsupported version {version} (this staregen reads version {VERSION})")
     values = {}
@@ -159,7 +159,7 @@ def _check(data) -> dict:
         if got is None:
             raise ConfigError(f"{table}: missing table [{table}]")
         if not isinstance(got, dict):
-            raise ConfigError(f"{table}: must be a table [{table}], got {_show(got)}")
+            raise ConfigError(f"{table}: must be a table [{table}], got {show_value(got)}")
         for key in got:
             if key not in keys:
                 raise ConfigError(f"{table}.{key}: unknown key (known in [{table}]: {', '.join(keys)})")
@@ -171,13 +171,13 @@ def _check(data) -> dict:
     return values
 
 
-def _canonical(v):
+def canonical_form(v):
     if isinstance(v, float):
         return v.hex()
     if isinstance(v, (list, tuple)):
-        return [_canonical(x) for x in v]
+        return [canonical_form(x) for x in v]
     if isinstance(v, dict):
-        return {k: _canonical(x) for k, x in v.items()}
+        return {k: canonical_form(x) for k, x in v.items()}
     return v
 
 
@@ -185,7 +185,7 @@ def values_sha256(mapping: dict) -> str:
     """sha256 of the canonical text of the values (reals as float.hex, so 17 and 17.0 hash alike)."""
     values = _check({k: v for k, v in mapping.items() if k != "sha256"})
     body = {"format": FORMAT, "version": VERSION, **values}
-    text = json.dumps(_canonical(body), sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    text = json.dumps(canonical_form(body), sort_keys=True, separators=(",", ":"), ensure_ascii=True)
     return hashlib.sha256(text.encode("ascii")).hexdigest()
 
 
@@ -195,7 +195,7 @@ def from_mapping(data: dict, sealed: bool = True) -> PackageConfig:
     if sealed:
         seal = data.get("sha256")
         if not isinstance(seal, str) or not re.fullmatch(r"[0-9a-f]{64}", seal):
-            raise ConfigError(f"sha256: missing or not 64 lower-case hex digits, got {_show(seal)}")
+            raise ConfigError(f"sha256: missing or not 64 lower-case hex digits, got {show_value(seal)}")
         actual = values_sha256(data)
         if actual != seal:
             raise ConfigError(f"sha256: mismatch: the values hash to {actual[:16]}..., the file states "

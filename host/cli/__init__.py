@@ -26,6 +26,7 @@ COMMANDS = [
     "host.cli.artifact",
     "host.cli.codegen",
     "host.cli.config",
+    "host.cli.scenario",
     "host.cli.generate",
     "host.cli.package",
     "host.cli.c_eval",

@@ -15,6 +15,7 @@ import functools
 import numpy as np
 
 from host.control.baselines import LinearLS, SaturatedLinear, load_baselines
+from host.control.batch import BatchLayout, BatchMeasurement, BatchOutput
 from host.control.controllers import ControlOutput, Measurement
 from host.control.nn_controller import clip_torque
 from host.errors import HostError
@@ -36,17 +37,39 @@ class BaselineController:
                              info={"A_bd": x.A_bd, "omega_e": x.omega_e})
 
 
+class BaselineBatch:
+    """BaselineController on rows."""
+
+    variants = 1
+
+    def __init__(self, name: str, law: LinearLS | SaturatedLinear, torque_limit: float):
+        self.name, self.law, self.torque_limit = name, law, float(torque_limit)
+
+    def reset(self, layout: BatchLayout) -> None:
+        """Stateless."""
+
+    def step(self, m: BatchMeasurement) -> BatchOutput:
+        with np.errstate(all="ignore"):
+            raw = self.law.predict(m.network_inputs_deg())
+        torque = clip_torque(raw, self.torque_limit)
+        return BatchOutput(torque=torque, saturated=np.any(torque != raw, 1))
+
+
 @functools.lru_cache(maxsize=4)
 def _laws(path: str):
     return load_baselines(path)
 
 
-def _make(name: str, torque_limit: float, baselines: str | None) -> BaselineController:
+def _law(name: str, baselines: str | None) -> LinearLS | SaturatedLinear:
     if baselines is None:
         raise HostError(f"controller {name} needs --baselines FILE (written by `staregen train` next to the "
                         "artifact, or network.baselines.json in a pipeline folder)")
     linear, pdff = _laws(str(baselines))
-    return BaselineController(name, pdff if name == "pdff" else linear, torque_limit)
+    return pdff if name == "pdff" else linear
+
+
+def _make(name: str, torque_limit: float, baselines: str | None) -> BaselineController:
+    return BaselineController(name, _law(name, baselines), torque_limit)
 
 
 def make_pdff_controller(*, torque_limit: float, control_period: float, baselines: str | None = None):
@@ -55,3 +78,11 @@ def make_pdff_controller(*, torque_limit: float, control_period: float, baseline
 
 def make_linear_controller(*, torque_limit: float, control_period: float, baselines: str | None = None):
     return _make("linear", torque_limit, baselines)
+
+
+def make_pdff_batch(*, torque_limit: float, control_period: float, baselines: str | None = None):
+    return BaselineBatch("pdff", _law("pdff", baselines), torque_limit)
+
+
+def make_linear_batch(*, torque_limit: float, control_period: float, baselines: str | None = None):
+    return BaselineBatch("linear", _law("linear", baselines), torque_limit)

@@ -58,6 +58,19 @@ CONTROLLERS = {
     "dp": "host.control.dp_controller:make_dp_controller",
     "dp-c": "host.control.dp_controller:make_dp_sil_controller",
 }
+# name -> "module:factory" of the batched form (host.control.batch: the same law on rows), for
+# every controller that has one; the batched simulator (host.sim.batched) flies these. The PIL run
+# (nn-arm) has none: the ARM emulator steps one record at a time.
+BATCH_CONTROLLERS = {
+    "pid": "host.control.pid:make_pid_batch",
+    "nn": "host.control.nn_controller:make_nn_batch",
+    "nn-c": "host.control.generated_controller:make_sil_batch",
+    "pid-c": "host.control.generated_controller:make_sil_pid_batch",
+    "pdff": "host.control.baseline_controllers:make_pdff_batch",
+    "linear": "host.control.baseline_controllers:make_linear_batch",
+    "dp": "host.control.dp_controller:make_dp_batch",
+    "dp-c": "host.control.dp_controller:make_dp_sil_batch",
+}
 # Controllers built from a model artifact accept `artifact=` (a file path, None = the stand-in).
 ARTIFACT_CONTROLLERS = ("nn", "nn-c", "pid-c", "nn-arm")
 # The fitted baselines accept `baselines=` (a baselines file written by `staregen train`).
@@ -66,11 +79,24 @@ BASELINE_CONTROLLERS = ("pdff", "linear")
 DP_CONTROLLERS = ("dp", "dp-c")
 
 
+def _build(registry: dict, name: str, torque_limit: float, control_period: float, options: dict):
+    if name not in registry:
+        raise HostError(f"unknown controller {name!r} (known: {', '.join(sorted(registry))})")
+    module, factory = registry[name].split(":")
+    return getattr(importlib.import_module(module), factory)(
+        torque_limit=torque_limit, control_period=control_period, **options)
+
+
 def build_controller(name: str, *, torque_limit: float, control_period: float, **options) -> Controller:
     """Instantiate a registered controller by name; unknown names are a user error.
     `options` go to the factory (e.g. artifact= for ARTIFACT_CONTROLLERS)."""
-    if name not in CONTROLLERS:
-        raise HostError(f"unknown controller {name!r} (known: {', '.join(sorted(CONTROLLERS))})")
-    module, factory = CONTROLLERS[name].split(":")
-    return getattr(importlib.import_module(module), factory)(
-        torque_limit=torque_limit, control_period=control_period, **options)
+    return _build(CONTROLLERS, name, torque_limit, control_period, options)
+
+
+def has_batch(name: str) -> bool:
+    return name in BATCH_CONTROLLERS
+
+
+def build_batch_controller(name: str, *, torque_limit: float, control_period: float, **options):
+    """The batched form (host.control.batch.BatchController) of a registered controller."""
+    return _build(BATCH_CONTROLLERS, name, torque_limit, control_period, options)

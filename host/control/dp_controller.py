@@ -14,13 +14,15 @@ import functools
 import numpy as np
 
 from codegen.artifact import table2_envelope
+from codegen.unit import Batch
 from codegen.units.dp import golden as dp_golden
 from codegen.units.dp import tables as dp_tables
 from codegen.units.dp.unit import DpUnit
 from host.control.discrete_point import DpModel, DpTables as DpTables64
-from host.control.nn_controller import Fig2Controller, flight_config
+from host.control.nn_controller import Fig2Batch, Fig2Controller, flight_config
 from host.errors import HostError
 from tools.inloop import InTheLoop
+from tools.runners import runner
 
 
 @functools.lru_cache(maxsize=4)
@@ -59,6 +61,43 @@ class GeneratedLaw:
         return out["torque"][0].astype(float), bool(out["status"][0] & dp_golden.STATUS_INVALID)
 
 
+class Float64LawRows:
+    """Float64Law on rows (the law is a search and a fit per query: one query per row)."""
+
+    def __init__(self, t: dp_tables.DpTables):
+        self.one = Float64Law(t)
+
+    def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        results = [self.one(x) for x in x_deg]
+        return np.array([r[0] for r in results]).reshape(-1, 3), np.array([r[1] for r in results], bool)
+
+
+class GeneratedLawRows:
+    """The generated step on x86 (cffi) for every flying row in one call of the unit's record runner."""
+
+    def __init__(self, t: dp_tables.DpTables):
+        self.unit = DpUnit(t)
+        self.run = runner(self.unit, "x86")
+
+    def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        rec = np.zeros(len(x_deg), dtype=dp_golden.INPUT_DTYPE)
+        with np.errstate(all="ignore"):
+            rec["x"] = x_deg.astype(np.float32)
+        out, _ = self.run.records(Batch(None, rec))
+        return out["torque"].astype(float), (out["status"] & dp_golden.STATUS_INVALID) != 0
+
+
+class DpBatch(Fig2Batch):
+    """DpController on rows."""
+
+    def __init__(self, name: str, law, torque_limit: float, control_period: float):
+        super().__init__(name, table2_envelope(), flight_config(torque_limit, control_period))
+        self._law = law
+
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self._law(x_deg)
+
+
 class DpController(Fig2Controller):
     law_mode = "dp"
 
@@ -82,3 +121,11 @@ def make_dp_controller(*, torque_limit: float, control_period: float, tables: st
 
 def make_dp_sil_controller(*, torque_limit: float, control_period: float, tables: str | None = None):
     return DpController("dp-c", GeneratedLaw(_tables(tables)), torque_limit, control_period)
+
+
+def make_dp_batch(*, torque_limit: float, control_period: float, tables: str | None = None):
+    return DpBatch("dp", Float64LawRows(_tables(tables)), torque_limit, control_period)
+
+
+def make_dp_sil_batch(*, torque_limit: float, control_period: float, tables: str | None = None):
+    return DpBatch("dp-c", GeneratedLawRows(_tables(tables)), torque_limit, control_period)

@@ -17,19 +17,34 @@ import dataclasses
 
 import numpy as np
 
+from codegen.unit import Batch
 from codegen.units.controller import spec as cs
 from codegen.units.controller.emit import INPUT_DTYPE, to_bam
 from codegen.units.controller.unit import ControllerUnit
+from host.control.batch import BatchLayout, BatchMeasurement, BatchOutput
 from host.control.controllers import ControlOutput, Measurement
 from host.control.nn_controller import flight_config, load_artifact
 from host.core.timebase import normalise_time
 from tools.inloop import InTheLoop
+from tools.runners import runner
 
 
 def pack_input(m: Measurement) -> np.ndarray:
     """One input record from a Measurement (float32 rounding happens here, as on board)."""
     jd, sec = normalise_time(int(m.jd_days), float(m.sec_of_day))
     rec = np.zeros(1, dtype=INPUT_DTYPE)
+    rec["A_bo"], rec["omega_b"] = m.A_bo, m.omega_b
+    rec["R_s"], rec["V_s"] = m.R_s, m.V_s
+    rec["lon"], rec["lat"] = to_bam(m.lon), to_bam(m.lat)
+    rec["utc_day"] = int(jd) - cs.J2000_JDN
+    rec["utc_ms"] = int(round(float(sec) * 1000.0))
+    return rec
+
+
+def pack_rows(m: BatchMeasurement) -> np.ndarray:
+    """pack_input for every row of a BatchMeasurement (one clock and one GPS fix for all rows)."""
+    jd, sec = normalise_time(int(m.jd_days), float(m.sec_of_day))
+    rec = np.zeros(m.rows, dtype=INPUT_DTYPE)
     rec["A_bo"], rec["omega_b"] = m.A_bo, m.omega_b
     rec["R_s"], rec["V_s"] = m.R_s, m.V_s
     rec["lon"], rec["lat"] = to_bam(m.lon), to_bam(m.lat)
@@ -62,6 +77,24 @@ class GeneratedController:
         return control_output(out, **extra)
 
 
+class GeneratedBatch:
+    """The controller unit on x86 for every row: one call of its record runner per control step, each
+    row's state carried from the previous call (SIL, batched)."""
+
+    variants = 1
+
+    def __init__(self, unit: ControllerUnit, name: str):
+        self.name, self.unit = name, unit
+        self.run = runner(unit, "x86")
+
+    def reset(self, layout: BatchLayout) -> None:
+        self.state = self.unit.init_state(layout.rows)
+
+    def step(self, m: BatchMeasurement) -> BatchOutput:
+        out, self.state = self.run.records(Batch(self.state, pack_rows(m)))
+        return BatchOutput(torque=out["torque"].astype(float), saturated=(out["status"] & cs.STATUS_SATURATED) != 0)
+
+
 def _unit(artifact: str | None, torque_limit: float, control_period: float, pid_only: bool = False):
     cfg = flight_config(torque_limit, control_period)
     return ControllerUnit(load_artifact(artifact), dataclasses.replace(cfg, pid_only=pid_only))
@@ -77,3 +110,11 @@ def make_sil_pid_controller(*, torque_limit: float, control_period: float, artif
 
 def make_pil_controller(*, torque_limit: float, control_period: float, artifact: str | None = None):
     return GeneratedController(_unit(artifact, torque_limit, control_period), "arm", "nn-arm")
+
+
+def make_sil_batch(*, torque_limit: float, control_period: float, artifact: str | None = None):
+    return GeneratedBatch(_unit(artifact, torque_limit, control_period), "nn-c")
+
+
+def make_sil_pid_batch(*, torque_limit: float, control_period: float, artifact: str | None = None):
+    return GeneratedBatch(_unit(artifact, torque_limit, control_period, pid_only=True), "pid-c")

@@ -23,6 +23,7 @@ from codegen import artifact as art
 from codegen.package.config import PackageConfig
 from codegen.units.controller import spec as cs
 from host.core.constants import DEG, MU_EARTH, WGS84_A, WGS84_E2
+from host.control.batch import BatchLayout, BatchMeasurement, BatchOutput
 from host.control.controllers import ControlOutput, Measurement
 from host.control.pid import TABLE1_GAINS
 from host.errors import HostError
@@ -189,6 +190,87 @@ class NnController(Fig2Controller):
         return network64(self.artifact, x_deg), False
 
 
+# ----------------------------------------------------------------------------- batched (rows)
+
+class ModeRows:
+    """ModeLogic on rows: the PID at once on a violation, the law back after dwell_steps clean steps."""
+
+    def __init__(self, dwell_steps: int, rows: int):
+        self.dwell_steps = dwell_steps
+        self.mode = np.full(rows, cs.MODE_NN)
+        self.count = np.zeros(rows, dtype=np.int64)
+
+    def update(self, clean: np.ndarray) -> np.ndarray:
+        in_pid = self.mode == cs.MODE_PID
+        count = np.where(clean & in_pid, np.minimum(self.count + 1, self.dwell_steps), self.count)
+        self.count = np.where(clean, count, 0)
+        back = clean & in_pid & (self.count >= self.dwell_steps)
+        self.mode = np.where(~clean, cs.MODE_PID, np.where(back, cs.MODE_NN, self.mode))
+        return self.mode
+
+
+class TrackingPidRows(TrackingPid):
+    """TrackingPid on (R, 3) rows (the same formulas; the gains broadcast over rows)."""
+
+    def reset(self, rows: int = 1) -> None:
+        self.integral = np.zeros((rows, 3))
+
+
+class Fig2Batch:
+    """Fig2Controller on rows: the law on the rows inside the envelope (after the dwell), the Table 1
+    PID elsewhere, then saturation. Subclasses give `law` on the flying rows and the envelope."""
+
+    variants = 1
+
+    def __init__(self, name: str, envelope: art.Envelope, cfg: cs.ControllerConfig):
+        self.name, self.envelope, self.cfg = name, envelope, cfg
+        self.lo, self.hi = envelope.min.astype(float), envelope.max.astype(float)
+
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(torque (r, 3) N·m, input invalid (r,)) for r rows of the 12 inputs in Table 2 units."""
+        raise NotImplementedError
+
+    def reset(self, layout: BatchLayout) -> None:
+        self.modes = ModeRows(self.cfg.dwell_steps, layout.rows)
+        self.pid = TrackingPidRows(self.cfg)
+        self.pid.reset(layout.rows)
+
+    def step(self, m: BatchMeasurement) -> BatchOutput:
+        with np.errstate(all="ignore"):
+            x_deg = m.network_inputs_deg()
+            inside = np.all((x_deg >= self.lo) & (x_deg <= self.hi), 1)
+        mode = self.modes.update(inside & m.finite())
+        raw = self.pid.step(m.A_bd / DEG, m.omega_e / DEG)
+        flying = np.flatnonzero(mode == cs.MODE_NN)
+        if flying.size:
+            law, invalid = self.law(x_deg[flying])
+            raw[flying[~invalid]] = law[~invalid]
+        torque = clip_torque(raw, self.cfg.torque_limit)
+        return BatchOutput(torque=torque, saturated=np.any(torque != raw, 1))
+
+
+def network64_rows(a: art.Artifact, X: np.ndarray) -> np.ndarray:
+    """network64 on (r, 12) rows."""
+    im, om = a.input_map, a.output_map
+    xn = (X - im.xoffset.astype(float)) * im.gain.astype(float) + float(im.ymin)
+    h = np.tanh(xn @ a.W1.astype(float).T + a.b1.astype(float))
+    yn = h @ a.W2.astype(float).T + a.b2.astype(float)
+    return (yn - float(om.ymin)) / om.gain.astype(float) + om.xoffset.astype(float)
+
+
+class NnBatch(Fig2Batch):
+    """NnController on rows (name "nn")."""
+
+    def __init__(self, artifact: art.Artifact, cfg: cs.ControllerConfig):
+        if artifact.sizes[0] != 12 or artifact.sizes[2] != 3:
+            raise HostError(f"the network controller needs a 12-input, 3-output network, got {artifact.shape_text}")
+        self.artifact = artifact
+        super().__init__("nn", artifact.envelope, cfg)
+
+    def law(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return network64_rows(self.artifact, x_deg), np.zeros(len(x_deg), bool)
+
+
 @functools.lru_cache(maxsize=4)
 def load_artifact(path: str | None) -> art.Artifact:
     """The artifact at `path`; None = the stand-in network fitted to the PID law (host.control.standin)."""
@@ -201,3 +283,7 @@ def load_artifact(path: str | None) -> art.Artifact:
 def make_nn_controller(*, torque_limit: float, control_period: float,
                        artifact: str | None = None) -> NnController:
     return NnController(load_artifact(artifact), flight_config(torque_limit, control_period))
+
+
+def make_nn_batch(*, torque_limit: float, control_period: float, artifact: str | None = None) -> NnBatch:
+    return NnBatch(load_artifact(artifact), flight_config(torque_limit, control_period))

@@ -14,8 +14,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from host.control.batch import BatchLayout, BatchMeasurement, BatchOutput
 from host.core.constants import DEG
 from host.control.controllers import ControlOutput, Measurement
+from host.errors import HostError
 from host.gnc.preprocess import preprocess
 
 
@@ -77,3 +79,62 @@ class PidController:
 def make_pid_controller(*, torque_limit: float, control_period: float,
                         gains: PidGains = TABLE1_GAINS) -> PidController:
     return PidController(gains, torque_limit, control_period)
+
+
+# ----------------------------------------------------------------------------- batched (rows)
+
+@dataclass(frozen=True)
+class GainSets:
+    """G PID gain sets (paper units: N·m/°, N·m/(°·s), N·m/(°/s)), each (G, 3) per axis."""
+    kp: np.ndarray
+    ki: np.ndarray
+    kd: np.ndarray
+
+    def __post_init__(self):
+        shapes = {np.shape(self.kp), np.shape(self.ki), np.shape(self.kd)}
+        if len(shapes) != 1 or len(next(iter(shapes))) != 2 or next(iter(shapes))[1] != 3:
+            raise HostError(f"gain sets: kp, ki, kd must all be (G, 3) arrays, got {sorted(shapes)}")
+        for name in ("kp", "ki", "kd"):
+            if not np.all(np.isfinite(getattr(self, name))):
+                raise HostError(f"gain sets: {name} has non-finite entries")
+
+    def __len__(self) -> int:
+        return int(np.shape(self.kp)[0])
+
+    @classmethod
+    def single(cls, kp, ki, kd) -> "GainSets":
+        return cls(np.atleast_2d(np.asarray(kp, float)), np.atleast_2d(np.asarray(ki, float)),
+                   np.atleast_2d(np.asarray(kd, float)))
+
+    @classmethod
+    def of(cls, gains: PidGains) -> "GainSets":
+        return cls.single(gains.kp, gains.ki, gains.kd)
+
+
+class PidBatch:
+    """PidLaw on rows, one gain set per variant (the Table 7 grid flies G gain sets side by side)."""
+
+    name = "pid"
+
+    def __init__(self, gains: GainSets, torque_limit: float = 1.0, control_period: float = 0.1):
+        self.gains, self.torque_limit, self.control_period = gains, float(torque_limit), float(control_period)
+        self.variants = len(gains)
+
+    def reset(self, layout: BatchLayout) -> None:
+        self.kp, self.ki, self.kd = (layout.per_variant(np.asarray(a, float))
+                                     for a in (self.gains.kp, self.gains.ki, self.gains.kd))
+        self.integral = np.zeros((layout.rows, 3))
+
+    def step(self, m: BatchMeasurement) -> BatchOutput:
+        A_deg, w_deg = m.A_bd / DEG, m.omega_e / DEG
+        finite = np.all(np.isfinite(A_deg) & np.isfinite(w_deg), 1)[:, None]
+        integral_next = self.integral + A_deg * self.control_period
+        raw = -((self.kp * A_deg + self.ki * integral_next) + self.kd * w_deg)
+        saturated = np.abs(raw) > self.torque_limit
+        self.integral = np.where(finite & ~saturated, integral_next, self.integral)
+        torque = np.where(finite, np.clip(raw, -self.torque_limit, self.torque_limit), 0.0)
+        return BatchOutput(torque=torque, saturated=np.any(saturated, 1) & finite[:, 0])
+
+
+def make_pid_batch(*, torque_limit: float, control_period: float, gains: PidGains = TABLE1_GAINS) -> PidBatch:
+    return PidBatch(GainSets.of(gains), torque_limit, control_period)

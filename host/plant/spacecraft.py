@@ -19,8 +19,9 @@ Limits (chosen here; the paper gives none):
   the body and the y wheel; 50 N·m·s is a typical 1000 kg-class wheel (e.g. 0.2-1 N·m,
   25-100 N·m·s units). A wheel at its momentum limit delivers no torque that would spin it up
   further.
-* wheel torque errors (Table 6): 0.01 N·m constant (same sign on the three wheels) plus 0.01 N·m
-  (1σ) white noise drawn once per control period (the command is held, so is its error).
+* wheel torque errors (Table 6): the scenario's error model (host.plant.error_model; the
+  `table6` reading: 0.01 N·m constant, same sign on the three wheels, plus 0.01 N·m (1σ) noise
+  drawn once per control period and held with the command), added at every plant step.
 """
 from __future__ import annotations
 
@@ -50,8 +51,6 @@ class SpacecraftParams:
     inertia: np.ndarray = field(default_factory=lambda: TABLE6_INERTIA.copy())  # kg m^2
     torque_limit: float = 1.0                              # N·m per wheel
     momentum_limit: float = 50.0                           # N·m·s per wheel
-    wheel_bias: np.ndarray = field(default_factory=lambda: np.full(3, 0.01))   # N·m (Table 6)
-    wheel_noise_sigma: float = 0.01                        # N·m, 1σ (Table 6)
 
     @functools.cached_property
     def inertia_inv(self) -> np.ndarray:
@@ -119,17 +118,8 @@ def momentum_limited_torque(M_c, h_w, momentum_limit: float) -> np.ndarray:
     return np.where(spinning_up, 0.0, M_c)
 
 
-class ReactionWheels:
-    """Three orthogonal wheels: saturation, then the Table 6 torque errors (seeded)."""
-
-    def __init__(self, params: SpacecraftParams, rng: np.random.Generator, errors: bool = True):
-        self.params = params
-        self.rng = rng
-        self.errors = errors
-
-    def applied_torque(self, M_cmd) -> np.ndarray:
-        """Torque the wheels put on the body for a command held over one control period."""
-        M = saturate_torque(np.asarray(M_cmd, dtype=float), self.params.torque_limit)
-        if self.errors:
-            M = M + self.params.wheel_bias + self.rng.normal(0.0, self.params.wheel_noise_sigma, 3)
-        return M
+def wheel_torque(M_cmd, limit: float, bias, noise, errors: bool = True) -> np.ndarray:
+    """Torque the wheels put on the body: the saturated command, then the Table 6 errors
+    ((saturated + bias) + noise: bias and noise from the scenario's error model)."""
+    M = saturate_torque(np.asarray(M_cmd, dtype=float), limit)
+    return (M + bias) + noise if errors else M

@@ -15,6 +15,7 @@ import numpy as np
 
 from host.core.constants import DEG
 from host.control.controllers import ARTIFACT_CONTROLLERS, build_controller
+from host.plant.error_model import TABLE6_ERRORS, ErrorModel
 from host.sim.simulator import History, SimConfig, simulate
 from host.sim.targets import central_target
 from codegen import atomic
@@ -62,11 +63,11 @@ def mode_times(t: np.ndarray, mode: np.ndarray) -> tuple[float | None, float | N
 
 
 def run(controller: str = "nn", artifact: str | None = None, duration: float = DEFAULT_DURATION,
-        seed: int = 0) -> ImpulseResult:
+        seed: int = 0, errors: ErrorModel = TABLE6_ERRORS) -> ImpulseResult:
     opts = {"artifact": artifact} if controller in ARTIFACT_CONTROLLERS else {}
     c = build_controller(controller, torque_limit=1.0, control_period=0.1, **opts)
     tg = central_target()
-    cfg = replace(SimConfig(duration=duration, seed=seed), extra_torque=impulse_torque)
+    cfg = replace(SimConfig(duration=duration, seed=seed, errors=errors), extra_torque=impulse_torque)
     h = simulate(c, tg.lon, tg.lat, cfg)
     t_pid, t_back = mode_times(h.t, h.mode)
     after = h.t >= IMPULSE_START

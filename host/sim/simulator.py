@@ -22,9 +22,13 @@ included); the torque arrays hold the torque applied over [t_j, t_j + τ), and t
 desired state computed from the true orbit; the controller's own view (from noisy sensors) is
 recorded too.
 
+Errors: the scenario's error model (SimConfig.errors, host.plant.error_model; default the `table6`
+reading): the star sensor and the gyro read (true + bias) + noise at the control instants, the wheels
+apply (saturated command + bias) + noise at every plant step, each noise drawn with its own period.
 Deterministic: the noise of target stream s under seed N comes from SeedSequence([N, s]), split
-into independent star-sensor, gyro and wheel generators, so results do not depend on the number
-of worker processes.
+into independent star-sensor, gyro and wheel generators and drawn once per run
+(error_model.draw_noise, shared with the batched simulator), so results do not depend on the
+number of worker processes.
 """
 from __future__ import annotations
 
@@ -44,9 +48,10 @@ from host.plant.environment import EnvironmentTrack
 from host.errors import HostError
 from host.gnc.guidance import desired_state
 from host.core.rotations import dcm_from_euler312, dcm_from_quat, euler312_from_dcm, quat_from_dcm
-from host.plant.sensors import TABLE6_SENSORS, Gps, Gyro, SensorErrors, StarSensor
-from host.plant.spacecraft import (TABLE6, ReactionWheels, SpacecraftParams, momentum_limited_torque,
-                             pack_state, rk4_step, unpack_state)
+from host.plant.error_model import TABLE6_ERRORS, ErrorModel, NoiseTrack, draw_noise
+from host.plant.sensors import Gps, measure
+from host.plant.spacecraft import (TABLE6, SpacecraftParams, momentum_limited_torque, pack_state, rk4_step,
+                                   unpack_state, wheel_torque)
 from host.core.timebase import add_seconds
 from host.core.vec3 import dcm_from_quat3
 
@@ -60,7 +65,7 @@ class SimConfig:
     plant_step: float = 0.02          # s, must divide the control period
     seed: int = 0
     spacecraft: SpacecraftParams = TABLE6
-    sensors: SensorErrors = TABLE6_SENSORS
+    errors: ErrorModel = TABLE6_ERRORS    # Table 6 sensor and wheel errors, as the scenario reads them
     disturbances: DisturbanceParams = DEFAULT_DISTURBANCES
     sensor_errors: bool = True        # False: perfect star sensor and gyro
     wheel_errors: bool = True         # False: wheels apply the saturated command exactly
@@ -144,21 +149,22 @@ class _Recorder:
         self.mode = np.empty(n, dtype=object)
 
 
-def _measure(x, env, k_sample, t, star, gyro, gps, lon, lat, cfg: SimConfig) -> Measurement:
+def _measure(x, env, k_sample, t, noise_star, noise_gyro, gps, lon, lat, cfg: SimConfig) -> Measurement:
     q, w, _ = unpack_state(x)
     L_bo = dcm_from_quat3(q) @ env.L_oi[k_sample].T
-    A_bo = star.measure(euler312_from_dcm(L_bo))
+    A_bo = measure(euler312_from_dcm(L_bo), cfg.errors.star, noise_star, cfg.sensor_errors)
     if cfg.attitude_offset is not None:
         A_bo = euler312_from_dcm(dcm_from_euler312(np.asarray(cfg.attitude_offset(t), float)) @ dcm_from_euler312(A_bo))
     R, V = gps.measure(env.R[k_sample], env.V[k_sample])
     return Measurement(t=t, jd_days=int(env.jd_days[k_sample]), sec_of_day=float(env.sec_of_day[k_sample]),
-                       A_bo=A_bo, omega_b=gyro.measure(w), R_s=R, V_s=V, lon=lon, lat=lat)
+                       A_bo=A_bo, omega_b=measure(w, cfg.errors.gyro, noise_gyro, cfg.sensor_errors),
+                       R_s=R, V_s=V, lon=lon, lat=lat)
 
 
-def _advance_one_period(x, M_c, j0: int, sub: int, env: EnvironmentTrack, rec: _Recorder,
-                        cfg: SimConfig) -> np.ndarray:
-    """Integrate the plant over one control period (sub RK4 steps) with the wheel torque held;
-    the momentum limit and the external torques are re-evaluated at each plant step."""
+def _advance_one_period(x, cmd, j0: int, sub: int, env: EnvironmentTrack, rec: _Recorder,
+                        cfg: SimConfig, wheel_noise: np.ndarray) -> np.ndarray:
+    """Integrate the plant over one control period (sub RK4 steps) with the command held; the wheel
+    errors, the momentum limit and the external torques are re-evaluated at each plant step."""
     sc = cfg.spacecraft
     inertia, inertia_inv = sc.inertia, sc.inertia_inv
     for j in range(j0, j0 + sub):
@@ -168,6 +174,7 @@ def _advance_one_period(x, M_c, j0: int, sub: int, env: EnvironmentTrack, rec: _
                  if cfg.external_torques else np.zeros(3))
         if cfg.extra_torque is not None:
             M_ext = M_ext + np.asarray(cfg.extra_torque(env.t[j]), float)
+        M_c = wheel_torque(cmd, sc.torque_limit, cfg.errors.wheels.bias_array, wheel_noise[j], cfg.wheel_errors)
         M_j = momentum_limited_torque(M_c, x[7:10], sc.momentum_limit)
         rec.applied[j], rec.ext[j] = M_j, M_ext
         x = rk4_step(x, M_j, M_ext, cfg.plant_step, inertia, inertia_inv)
@@ -177,34 +184,35 @@ def _advance_one_period(x, M_c, j0: int, sub: int, env: EnvironmentTrack, rec: _
 def simulate(controller: Controller, lon: float, lat: float, config: SimConfig = SimConfig(),
              stream: int = 0) -> History:
     """Fly `controller` staring at (lon, lat) [rad] for config.duration seconds."""
-    cfg, sc = config, config.spacecraft
+    cfg = config
     sub, n_ctrl = cfg.substeps, cfg.control_steps
     n = n_ctrl * sub
     env = environment_track(n + 1, cfg.plant_step)
-    star_rng, gyro_rng, wheel_rng = (np.random.default_rng(s)
-                                     for s in np.random.SeedSequence([cfg.seed, stream]).spawn(3))
-    star = StarSensor(cfg.sensors, star_rng, cfg.sensor_errors)
-    gyro = Gyro(cfg.sensors, gyro_rng, cfg.sensor_errors)
+    noise = run_noise(cfg, cfg.seed, stream)
     gps = Gps()
-    wheels = ReactionWheels(sc, wheel_rng, cfg.wheel_errors)
 
     controller.reset()
     x = initial_state(env, lon, lat)
     rec = _Recorder(n)
     for k in range(n_ctrl):
         j0 = k * sub
-        out = controller.step(_measure(x, env, j0, env.t[j0], star, gyro, gps, lon, lat, cfg))
+        out = controller.step(_measure(x, env, j0, env.t[j0], noise.star[k], noise.gyro[k], gps, lon, lat, cfg))
         cmd = np.asarray(out.torque, float)
-        M_c = wheels.applied_torque(cmd)
         rec.cmd[j0:j0 + sub] = cmd
         rec.mode[j0:j0 + sub] = out.mode
         rec.A_ctrl[j0:j0 + sub] = out.info.get("A_bd", np.nan)
         rec.w_ctrl[j0:j0 + sub] = out.info.get("omega_e", np.nan)
-        x = _advance_one_period(x, M_c, j0, sub, env, rec, cfg)
+        x = _advance_one_period(x, cmd, j0, sub, env, rec, cfg, noise.wheels)
     rec.x[n] = x
     for a in (rec.cmd, rec.applied, rec.ext, rec.A_ctrl, rec.w_ctrl, rec.mode):
         a[n] = a[n - 1]
     return _history(rec, env, n + 1, lon, lat, cfg, stream)
+
+
+def run_noise(cfg: SimConfig, seed: int, stream: int) -> NoiseTrack:
+    """The random sensor and wheel errors of one run (the same draws in every simulator)."""
+    return draw_noise(cfg.errors, seed, stream, cfg.control_steps, cfg.control_period, cfg.substeps,
+                      sensors=cfg.sensor_errors, wheels=cfg.wheel_errors)
 
 
 def true_errors(env: EnvironmentTrack, q_bi, omega_b, lon: float, lat: float):

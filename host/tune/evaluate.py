@@ -1,10 +1,16 @@
 """`staregen evaluate`: the comparisons of paper 001 §7 for the controllers this project makes.
 
+Engines. `batched` (the default): every controller with a batched form (host.control.controllers.
+BATCH_CONTROLLERS: the PIDs, the network in float64 and as generated C (SIL, through its record
+runner), PD+FF, the discrete-point law and its C) flies in one batched run per experiment, the
+controllers side by side as the variants of one bank (host.control.batch.ControllerBank) on common
+noise; each batched law equals its scalar run to 1e-9 (tests/host/sim/test_batched_laws.py). The
+PIL run (central target only: the ARM emulator steps one record at a time) flies on the scalar
+simulator. `scalar`: every controller on the scalar simulator, one process per core (the reference,
+kept for the side-by-side benchmark).
+
 * Staring (Tables 8-9, Fig. 10): J_A, J_ω, J (eq. 6-8, 25-27) of every controller over the
-  targets, per target for the scatter. The PIDs (Table 1 and tuned) fly on the batched simulator
-  (equal to the scalar one to 1e-9, tests/host/sim/test_batched.py); the network (float64, SIL),
-  the PD + feed-forward baseline and the PIL run (central target only: the ARM emulator is slow)
-  fly on the scalar simulator, one process per core.
+  targets, per target for the scatter, and on the central target alone (Table 8).
 * Step response (§7.6.1, Tables 10-11, Figs. 11-12): per controller and target, two runs with the
   same noise, one with an extra 0.005° star-sensor error on the three axes from 30 s; their
   difference d(t) of the true A_bd is the response (the controller drives the true attitude to
@@ -29,11 +35,13 @@ from typing import Callable
 
 import numpy as np
 
-from host.control.controllers import build_controller
+from host.control.batch import ControllerBank
+from host.control.controllers import build_batch_controller, build_controller, has_batch
 from host.control.pid import TABLE1_GAINS, PidGains
 from host.core.constants import DEG
 from host.errors import HostError
-from host.sim.batched import GainSets, simulate_pid_batch
+from host.plant.error_model import TABLE6_ERRORS, ErrorModel
+from host.sim.batched import simulate_batch
 from host.sim.metrics import K1, K2, staring_metrics
 from host.sim.simulator import SimConfig, simulate
 
@@ -41,6 +49,7 @@ STEP_DEG = 0.005
 STEP_AT = 30.0
 SETTLE_BAND = 0.05
 TORQUE_AMPLITUDE = 0.03
+ENGINES = ("batched", "scalar")
 
 
 @dataclass(frozen=True)
@@ -67,19 +76,57 @@ class SineTorque:
 
 
 @dataclass(frozen=True)
+class StepOffsetRows:
+    """StepOffset on the rows whose target index is `first_stepped` or later (the stepped copies)."""
+    targets: int
+    first_stepped: int
+    per_target_rows: int
+    t0: float = STEP_AT
+    deg: float = STEP_DEG
+
+    def __call__(self, t: float) -> np.ndarray:
+        out = np.zeros((self.targets * self.per_target_rows, 3))
+        if t >= self.t0:
+            out[self.first_stepped * self.per_target_rows:] = self.deg * DEG
+        return out
+
+
+@dataclass(frozen=True)
+class SineTorqueRows:
+    """SineTorque per target copy: copy 0 undisturbed, copy 1 + a·F + k on axis a at freqs[k]."""
+    freqs: tuple[float, ...]
+    per_target_rows: int
+    amplitude: float = TORQUE_AMPLITUDE
+
+    def __call__(self, t: float) -> np.ndarray:
+        F = len(self.freqs)
+        per_copy = np.zeros((1 + 3 * F, 3))
+        for a in range(3):
+            per_copy[1 + a * F:1 + (a + 1) * F, a] = self.amplitude * np.sin(2.0 * np.pi * np.asarray(self.freqs) * t)
+        return np.repeat(per_copy, self.per_target_rows, axis=0)
+
+
+@dataclass(frozen=True)
 class ControllerSpec:
-    """One evaluated controller: its registry name and factory options, or PID gains (batched)."""
+    """One evaluated controller: its registry name and factory options, or PID gains."""
     label: str
     name: str
     options: tuple = ()
     gains: PidGains | None = None
 
-    def factory(self, torque_limit: float, control_period: float) -> Callable:
+    def _options(self) -> dict:
         opts = dict(self.options)
         if self.gains is not None:
             opts["gains"] = self.gains
+        return opts
+
+    def factory(self, torque_limit: float, control_period: float) -> Callable:
         return functools.partial(build_controller, self.name, torque_limit=torque_limit,
-                                 control_period=control_period, **opts)
+                                 control_period=control_period, **self._options())
+
+    def batch(self, torque_limit: float, control_period: float):
+        return build_batch_controller(self.name, torque_limit=torque_limit, control_period=control_period,
+                                      **self._options())
 
 
 @dataclass(frozen=True)
@@ -95,8 +142,18 @@ class EvalPlan:
     freq_settle: float = 20.0
     k1: float = K1
     k2: float = K2
+    errors: ErrorModel = TABLE6_ERRORS
+    engine: str = "batched"
+
+    def config(self, duration: float, **extra) -> SimConfig:
+        return SimConfig(duration=duration, seed=self.seed, errors=self.errors, **extra)
+
+    def batched(self, spec: "ControllerSpec") -> bool:
+        return self.engine == "batched" and has_batch(spec.name)
 
     def __post_init__(self):
+        if self.engine not in ENGINES:
+            raise HostError(f"unknown engine {self.engine!r} (choose from {', '.join(ENGINES)})")
         if not self.targets or not self.response_targets:
             raise HostError("evaluation needs at least one target for the tables and one for the responses")
         if not self.freqs or any(not (0.0 < f < 5.0) for f in self.freqs):
@@ -141,34 +198,53 @@ def _run(fn, jobs: list[tuple], workers: int | None, progress: bool, desc: str) 
     return results
 
 
+# ----------------------------------------------------------------------------- the batched runs
+
+def _bar_callback(total: int, progress: bool, desc: str):
+    """(callback(k), close()) of a tqdm bar over the control steps of one batched run."""
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, desc=desc, unit="step", disable=not progress, mininterval=0.5)
+    return (lambda k: bar.update()), bar.close
+
+
+def _fly_bank(plan: EvalPlan, specs: list[ControllerSpec], targets: list[tuple[float, float]], streams: list[int],
+              cfg: SimConfig, progress: bool, desc: str, record: bool = False):
+    """Every spec side by side in one batched run; the result's variant g is specs[g]."""
+    bank = ControllerBank([s.batch(cfg.spacecraft.torque_limit, cfg.control_period) for s in specs])
+    update, close = _bar_callback(cfg.control_steps, progress, desc)
+    try:
+        return simulate_batch(bank, targets, (plan.seed,), cfg, streams=streams, record=record, progress=update)
+    finally:
+        close()
+
+
+def _split(plan: EvalPlan, specs: list[ControllerSpec]) -> tuple[list, list]:
+    """(specs flown batched, specs flown on the scalar simulator)."""
+    return [s for s in specs if plan.batched(s)], [s for s in specs if not plan.batched(s)]
+
+
 # ----------------------------------------------------------------------------- staring (Tables 8-9)
 
 def staring(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True,
             known: dict | None = None) -> dict:
     """Rows of the staring table; `known` rows (label -> row) are taken as they are, not flown again."""
-    cfg = SimConfig(duration=plan.duration, seed=plan.seed)
-    rows = {}
-    pids = [s for s in specs if s.gains is not None]
-    if pids:
-        gains = GainSets(np.array([s.gains.kp for s in pids]), np.array([s.gains.ki for s in pids]),
-                         np.array([s.gains.kd for s in pids]))
-        res = simulate_pid_batch([(lon, lat) for _, lon, lat, _ in plan.targets], gains, (plan.seed,), cfg,
-                                 streams=[s for *_, s in plan.targets])
-        for g, spec in enumerate(pids):
+    cfg = plan.config(plan.duration)
+    known = known or {}
+    batched, scalar = _split(plan, [s for s in specs if s.label not in known])
+    rows = dict(known)
+    if batched:
+        res = _fly_bank(plan, batched, [(lon, lat) for _, lon, lat, _ in plan.targets],
+                        [s for *_, s in plan.targets], cfg, progress, f"staring ({len(plan.targets)} targets)")
+        for g, spec in enumerate(batched):
             rows[spec.label] = _row(res.J_A[:, g, 0], res.J_w[:, g, 0], plan)
-    for spec in specs:
-        if spec.gains is not None:
-            continue
-        if known and spec.label in known:
-            rows[spec.label] = known[spec.label]
-            continue
+    for spec in scalar:
         targets = [plan.central] if spec.name == "nn-arm" else list(plan.targets)
         make = spec.factory(cfg.spacecraft.torque_limit, cfg.control_period)
         out = _run(_job_metrics, [(make, lon, lat, cfg, s) for _, lon, lat, s in targets], workers, progress,
                    f"staring {spec.label}")
         rows[spec.label] = _row(np.array([o["J_A"] for o in out]), np.array([o["J_w"] for o in out]), plan)
-        rows[spec.label]["targets"] = len(targets)
-    return rows
+    return {s.label: rows[s.label] for s in specs}
 
 
 def _row(J_A: np.ndarray, J_w: np.ndarray, plan: EvalPlan) -> dict:
@@ -194,24 +270,37 @@ def step_metrics(d_deg: np.ndarray, t: np.ndarray, t0: float = STEP_AT, step: fl
     return {"overshoot_pct": overshoot.tolist(), "settling_s": settling.tolist(), "steady_state_deg": steady.tolist()}
 
 
+def _step_entry(pairs: list[np.ndarray], t: np.ndarray) -> dict:
+    """Mean step metrics over the targets and the first target's response, from (base, stepped)
+    histories of true A_bd (deg) at the control instants."""
+    per_target = [step_metrics(stepped - base, t) for base, stepped in pairs]
+    mean = {k: np.mean([p[k] for p in per_target], axis=0).tolist() for k in per_target[0]}
+    first = pairs[0][1] - pairs[0][0]
+    return {"mean": mean, "targets": len(per_target), "first_target_response_deg": first[t >= STEP_AT - 5.0].tolist(),
+            "t": t[t >= STEP_AT - 5.0].tolist()}
+
+
 def step_response(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True) -> dict:
-    base = SimConfig(duration=plan.step_duration, seed=plan.seed)
-    stepped = replace(base, attitude_offset=StepOffset())
+    base = plan.config(plan.step_duration)
     t = np.arange(base.control_steps + 1) * base.control_period
+    specs = [s for s in specs if s.name != "nn-arm"]
+    batched, scalar = _split(plan, specs)
     out = {}
-    for spec in specs:
-        if spec.name == "nn-arm":
-            continue
+    if batched:   # the targets twice: copies 0..n-1 plain, n..2n-1 with the offset
+        n = len(plan.response_targets)
+        targets = [(lon, lat) for _, lon, lat, _ in plan.response_targets] * 2
+        streams = [s for *_, s in plan.response_targets] * 2
+        cfg = replace(base, attitude_offset=StepOffsetRows(2 * n, n, len(batched)))
+        res = _fly_bank(plan, batched, targets, streams, cfg, progress, f"step ({n} targets)", record=True)
+        for g, spec in enumerate(batched):
+            out[spec.label] = _step_entry([(res.A_bd_deg[i, g, 0], res.A_bd_deg[n + i, g, 0]) for i in range(n)], t)
+    stepped = replace(base, attitude_offset=StepOffset())
+    for spec in scalar:
         make = spec.factory(base.spacecraft.torque_limit, base.control_period)
         jobs = [(make, lon, lat, c, s) for _, lon, lat, s in plan.response_targets for c in (base, stepped)]
         hist = _run(_job_history, jobs, workers, progress, f"step {spec.label}")
-        per_target = [step_metrics(hist[2 * i + 1] - hist[2 * i], t) for i in range(len(plan.response_targets))]
-        mean = {k: np.mean([p[k] for p in per_target], axis=0).tolist() for k in per_target[0]}
-        central = hist[1] - hist[0]
-        out[spec.label] = {"mean": mean, "targets": len(per_target),
-                           "first_target_response_deg": central[t >= STEP_AT - 5.0].tolist(),
-                           "t": t[t >= STEP_AT - 5.0].tolist()}
-    return out
+        out[spec.label] = _step_entry([(hist[2 * i], hist[2 * i + 1]) for i in range(len(plan.response_targets))], t)
+    return {s.label: out[s.label] for s in specs}
 
 
 # ----------------------------------------------------------------------------- frequency response (Figs. 13-14)
@@ -224,25 +313,38 @@ def sine_amplitude(d: np.ndarray, t: np.ndarray, hz: float) -> float:
     return float(np.hypot(coef[0], coef[1]))
 
 
+def _amplitudes(hist: list[np.ndarray], t: np.ndarray, keep: np.ndarray, freqs: tuple[float, ...]) -> list:
+    """(3, F) attitude amplitudes from histories [undisturbed, axis a at freqs[k] (index 1 + a·F + k)]."""
+    mags = np.zeros((3, len(freqs)))
+    for a in range(3):
+        for k, f in enumerate(freqs):
+            d = hist[1 + a * len(freqs) + k][:, a] - hist[0][:, a]
+            mags[a, k] = sine_amplitude(d[keep], t[keep], f)
+    return mags.tolist()
+
+
 def frequency_response(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True) -> dict:
-    base = SimConfig(duration=plan.freq_duration, seed=plan.seed)
+    base = plan.config(plan.freq_duration)
     t = np.arange(base.control_steps + 1) * base.control_period
     keep = t >= plan.freq_settle
     _, lon, lat, stream = plan.central
+    specs = [s for s in specs if s.name != "nn-arm"]
+    batched, scalar = _split(plan, specs)
+    copies = 1 + 3 * len(plan.freqs)
     out = {}
-    for spec in specs:
-        if spec.name == "nn-arm":
-            continue
+    if batched:   # the central target once undisturbed and once per (axis, frequency)
+        cfg = replace(base, extra_torque=SineTorqueRows(tuple(plan.freqs), len(batched)))
+        res = _fly_bank(plan, batched, [(lon, lat)] * copies, [stream] * copies, cfg, progress,
+                        f"frequency ({copies} runs)", record=True)
+        for g, spec in enumerate(batched):
+            hist = [res.A_bd_deg[c, g, 0] for c in range(copies)]
+            out[spec.label] = {"freqs_hz": list(plan.freqs), "amplitude_deg": _amplitudes(hist, t, keep, plan.freqs)}
+    for spec in scalar:
         make = spec.factory(base.spacecraft.torque_limit, base.control_period)
         cfgs = [base] + [replace(base, extra_torque=SineTorque(a, f)) for a in range(3) for f in plan.freqs]
         hist = _run(_job_history, [(make, lon, lat, c, stream) for c in cfgs], workers, progress, f"frequency {spec.label}")
-        mags = np.zeros((3, len(plan.freqs)))
-        for a in range(3):
-            for k, f in enumerate(plan.freqs):
-                d = hist[1 + a * len(plan.freqs) + k][:, a] - hist[0][:, a]
-                mags[a, k] = sine_amplitude(d[keep], t[keep], f)
-        out[spec.label] = {"freqs_hz": list(plan.freqs), "amplitude_deg": mags.tolist()}
-    return out
+        out[spec.label] = {"freqs_hz": list(plan.freqs), "amplitude_deg": _amplitudes(hist, t, keep, plan.freqs)}
+    return {s.label: out[s.label] for s in specs}
 
 
 def evaluate(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True) -> dict:
@@ -267,7 +369,8 @@ def evaluate(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress
     result["plan"] = {"targets": len(plan.targets), "response_targets": len(plan.response_targets),
                       "duration": plan.duration, "seed": plan.seed, "step_duration": plan.step_duration,
                       "freqs_hz": list(plan.freqs), "freq_duration": plan.freq_duration,
-                      "freq_settle": plan.freq_settle, "k1": plan.k1, "k2": plan.k2}
+                      "freq_settle": plan.freq_settle, "k1": plan.k1, "k2": plan.k2, "engine": plan.engine,
+                      "error_reading": plan.errors.reading}
     return result
 
 
