@@ -38,6 +38,7 @@ COMMANDS = [
     "host.cli.impulse",
     "host.cli.tune",
     "host.cli.evaluate",
+    "host.cli.calibrate",
     "host.cli.report",
     "host.cli.tanh",
     "host.cli.dp",

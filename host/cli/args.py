@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 from host.errors import HostError
+from host.sim import scenario_file
 
 
 def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None) -> int:
@@ -35,3 +36,16 @@ def parse_number(text: str, what: str, *, positive: bool = False, non_negative: 
     if maximum is not None and value > maximum:
         raise HostError(f"{what} must be at most {maximum:g}, got {text}")
     return value
+
+
+SCENARIO_HELP = ("scenario file (`staregen scenario init`): the reading of Table 6's sensor and wheel errors "
+                 "(default: the built-in `table6` reading)")
+
+
+def add_scenario_argument(parser) -> None:
+    parser.add_argument("--scenario", default=None, metavar="FILE", help=SCENARIO_HELP)
+
+
+def load_scenario(path: str | None):
+    """The --scenario file, validated (one-line error), or the default `table6` reading."""
+    return scenario_file.default_scenario() if path is None else scenario_file.load(path)

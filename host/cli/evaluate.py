@@ -4,6 +4,11 @@ PID with Table 1 gains, the tuned PID and the PD + feed-forward baseline; evalua
   --network FILE       the trained artifact (its baselines file next to it is used for PD+FF)
   --tuned FILE         a controller.toml from `staregen tune pid` (adds the tuned PID row)
   --sil / --pil        add the generated C in the loop: SIL over the targets, PIL on the central one
+  --scenario FILE      the reading of Table 6's errors (default `table6`), recorded in evaluate.json
+  --quick              the small preset (3 targets × 20 s, one step-response target, two frequencies),
+                       flagged as not comparable with the paper in evaluate.json and the report
+Paper scale by default: 100 targets × 100 s staring, the step response over the 100, nine
+frequencies, on the batched simulator (--engine scalar flies the scalar reference instead).
 """
 from __future__ import annotations
 
@@ -12,7 +17,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen.package import config as pc
-from host.cli.args import parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.cli.tune import parse_targets
 from host.control.baselines import load_baselines
 from host.errors import HostError
@@ -22,7 +27,7 @@ from host.sim.campaign import check_targets_visible
 from host.sim.simulator import SimConfig
 from host.sim.targets import Target, central_target
 from host.tune import figures
-from host.tune.evaluate import ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
+from host.tune.evaluate import ENGINES, QUICK, ControllerSpec, EvalPlan, evaluate, table1_spec, tuned_spec
 
 
 def register(subparsers) -> None:
@@ -36,7 +41,8 @@ def register(subparsers) -> None:
                    help="discrete-point tables (`staregen dp build`): adds the paper-003 law (and its C with --sil)")
     p.add_argument("--targets", default="all",
                    help="staring targets: all, central, N (the first N of the 100) or a target list file")
-    p.add_argument("--response-targets", default="10", help="targets averaged in the step response (default 10)")
+    p.add_argument("--response-targets", default="all",
+                   help="targets averaged in the step response: all (default: every staring target) or N (the first N)")
     p.add_argument("--duration", default="100", help="staring run length in s (default 100)")
     p.add_argument("--freqs", default="0.02,0.05,0.1,0.2,0.5,1,2,3,4.5", help="frequency grid in Hz")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
@@ -44,7 +50,12 @@ def register(subparsers) -> None:
                    help="comma-separated subset of " + ", ".join(KEYS) + " (default: every one available)")
     p.add_argument("--sil", action="store_true", help="add the generated C (x86, cffi) over the targets")
     p.add_argument("--pil", action="store_true", help="add the generated C in the ARM emulator, central target")
-    p.add_argument("--workers", default=None, help="worker processes (default: all cores)")
+    add_scenario_argument(p)
+    p.add_argument("--quick", action="store_true",
+                   help="small preset: 3 targets x 20 s, 1 step-response target, 2 frequencies (not comparable)")
+    p.add_argument("--engine", default="batched", choices=ENGINES,
+                   help="batched (default) or the scalar reference simulator")
+    p.add_argument("--workers", default=None, help="worker processes of the scalar runs (default: all cores)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     p.add_argument("--out", required=True, help="output folder (created)")
     p.set_defaults(func=run)
@@ -107,21 +118,37 @@ def parse_freqs(text: str) -> tuple[float, ...]:
     return tuple(parse_number(p, "--freqs", positive=True, maximum=4.99) for p in parts)
 
 
-def run(args: argparse.Namespace) -> int:
-    targets = parse_targets(args.targets)
-    n_resp = parse_int(args.response_targets, "--response-targets", minimum=1, maximum=len(targets))
+def build_plan(args, errors) -> EvalPlan:
+    """The evaluation plan from the arguments: paper scale, or the --quick preset."""
     c = central_target()
-    plan = EvalPlan(targets=targets, response_targets=targets[:n_resp], central=(c.name, c.lon, c.lat, 0),
+    central = (c.name, c.lon, c.lat, 0)
+    if args.quick:
+        targets = parse_targets(str(QUICK["targets"]))
+        return EvalPlan(targets=targets, response_targets=targets[:QUICK["response_targets"]], central=central,
+                        duration=QUICK["duration"], seed=parse_int(args.seed, "--seed", maximum=2**32 - 1),
+                        freqs=QUICK["freqs"], freq_duration=QUICK["freq_duration"], errors=errors,
+                        engine=args.engine, preset="quick")
+    targets = parse_targets(args.targets)
+    n_resp = len(targets) if args.response_targets.strip().lower() == "all" else parse_int(
+        args.response_targets, "--response-targets", minimum=1, maximum=len(targets))
+    return EvalPlan(targets=targets, response_targets=targets[:n_resp], central=central,
                     duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
-                    seed=parse_int(args.seed, "--seed", maximum=2**32 - 1), freqs=parse_freqs(args.freqs))
+                    seed=parse_int(args.seed, "--seed", maximum=2**32 - 1), freqs=parse_freqs(args.freqs),
+                    errors=errors, engine=args.engine)
+
+
+def run(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
+    plan = build_plan(args, scenario.errors)
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1, maximum=256)
-    check_targets_visible([Target(n, lon, lat) for n, lon, lat, _ in targets], SimConfig(duration=plan.duration))
+    check_targets_visible([Target(n, lon, lat) for n, lon, lat, _ in plan.targets], SimConfig(duration=plan.duration))
     specs = controller_specs(args)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise HostError(f"output folder {out} exists and is not a directory")
-    result = figures.write_evaluation(evaluate(plan, specs, workers, progress=not args.no_progress),
-                                      args.network, plan.seed, out)
+    result = evaluate(plan, specs, workers, progress=not args.no_progress)
+    result["scenario"] = scenario.describe()
+    result = figures.write_evaluation(result, args.network, plan.seed, out, scenario.errors)
     print(summary(result))
     print(f"wrote {out}/evaluate.json and 4 figures")
     return 0

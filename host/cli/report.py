@@ -14,6 +14,8 @@ def register(subparsers) -> None:
                               description=__doc__.splitlines()[0])
     p.add_argument("--evaluate", required=True, metavar="DIR", help="folder written by `staregen evaluate`")
     p.add_argument("--tune", default=None, metavar="DIR", help="folder written by `staregen tune pid`")
+    p.add_argument("--calibration", default=None, metavar="DIR",
+                   help="folder written by `staregen calibrate` (adds the section 'Fidelity to paper 001')")
     p.add_argument("--command", action="append", default=[], help="a command of the run, to list (repeatable)")
     p.add_argument("--out", required=True, help="report folder (created)")
     p.set_defaults(func=run)
@@ -29,6 +31,9 @@ def run(args: argparse.Namespace) -> int:
     tune_dir = Path(args.tune) if args.tune else None
     if tune_dir is not None and not tune_dir.is_dir():
         raise HostError(f"--tune {tune_dir}: not a folder")
-    paths = write_report(out, evaluate_dir, tune_dir, args.command)
+    cal_dir = Path(args.calibration) if args.calibration else None
+    if cal_dir is not None and not cal_dir.is_dir():
+        raise HostError(f"--calibration {cal_dir}: not a folder")
+    paths = write_report(out, evaluate_dir, tune_dir, args.command, cal_dir)
     print(f"wrote {paths['md']} and {paths['html']}")
     return 0

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from host.sim import tanh_example, tanh_in_loop
-from host.cli.args import parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
 from host.control.baselines import load_baselines
 from host.control.controllers import ARTIFACT_CONTROLLERS, BASELINE_CONTROLLERS, CONTROLLERS, DP_CONTROLLERS
@@ -49,6 +49,7 @@ def register(subparsers) -> None:
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
     p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
+    add_scenario_argument(p)
     p.add_argument("--t-img", default="1.0", help="imaging window length T_img in s (default 1)")
     p.add_argument("--settle", default="10.0", help="start of the first imaging window in s (default 10)")
     p.add_argument("--workers", default=None, help="worker processes for several targets (default: all cores)")
@@ -73,9 +74,9 @@ def check_output_folder(out: Path, marker: str = "metrics.json") -> None:
             break
 
 
-def build_config(args) -> SimConfig:
+def build_config(args, errors) -> SimConfig:
     return SimConfig(duration=parse_number(args.duration, "--duration", positive=True, maximum=MAX_DURATION_S),
-                     seed=parse_int(args.seed, "--seed"))
+                     seed=parse_int(args.seed, "--seed"), errors=errors)
 
 
 def build_plan(args) -> ImagingPlan:
@@ -157,7 +158,8 @@ def main(args: argparse.Namespace) -> int:
     if args.period is not None or args.dt is not None:
         raise HostError("--period and --dt apply to --controller tanh only")
     targets = parse_target(args.target)
-    config, plan = build_config(args), build_plan(args)
+    scenario = load_scenario(args.scenario)
+    config, plan = build_config(args, scenario.errors), build_plan(args)
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
     options = controller_options(args)
     out = Path(args.out)
@@ -166,7 +168,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         with atomic.directory(out) as tmp:
             result = run_campaign(args.controller, targets, config, plan, workers=workers, options=options)
-            write_campaign(result, tmp)
+            write_campaign(result, tmp, scenario.describe())
     except OSError as exc:
         raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
     print(format_table(result))

@@ -12,7 +12,7 @@ import argparse
 from pathlib import Path
 
 from codegen.package import config as pc
-from host.cli.args import parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.control.nn_controller import default_package_config
 from host.errors import HostError
 from host.sim.campaign import check_targets_visible
@@ -34,6 +34,7 @@ def register(subparsers) -> None:
     pid.add_argument("--shard-size", default="60", help="gain triples per shard (default 60)")
     pid.add_argument("--config", default=None, metavar="FILE",
                      help="controller configuration to start from (default: `staregen config init`'s)")
+    add_scenario_argument(pid)
     pid.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (default: local cluster)")
     pid.add_argument("--workers", default=None, help="local cluster worker processes (default: all cores)")
     pid.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -68,14 +69,16 @@ def parse_seeds(text: str) -> tuple[int, ...]:
 
 
 def run_pid(args: argparse.Namespace) -> int:
+    scenario = load_scenario(args.scenario)
     plan = TuningPlan(grid=grid(args.grid), targets=parse_targets(args.targets), seeds=parse_seeds(args.seeds),
                       duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
-                      shard_size=parse_int(args.shard_size, "--shard-size", minimum=1, maximum=100_000))
+                      shard_size=parse_int(args.shard_size, "--shard-size", minimum=1, maximum=100_000),
+                      errors=scenario.errors, scenario=scenario.describe())
     check_targets_visible([Target(n, lon, lat) for n, lon, lat, _ in plan.targets], plan.sim_config())
     base = pc.load(args.config) if args.config else default_package_config()
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1, maximum=256)
     out = Path(args.out)
-    print(f"tune pid: grid {plan.grid.name} ({len(plan.grid)} triples) x {len(plan.targets)} target(s) x "
+    print(f"tune pid: scenario {scenario.reading} (sha256 {scenario.sha256[:12]}), grid {plan.grid.name} ({len(plan.grid)} triples) x {len(plan.targets)} target(s) x "
           f"{len(plan.seeds)} seed(s), {plan.duration:g} s each, {plan.n_shards} shard(s)")
     doc = tune(out, plan, base, scheduler=args.scheduler, workers=workers, progress=not args.no_progress)
     t = doc["timing"]

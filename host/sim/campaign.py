@@ -93,9 +93,10 @@ def _target_row(tg: Target, h: History, m: StaringMetrics, plan: ImagingPlan) ->
     }
 
 
-def metrics_document(r: CampaignResult) -> dict:
+def metrics_document(r: CampaignResult, scenario: dict | None = None) -> dict:
     cfg = r.config
     return {
+        "scenario": scenario or {"reading": cfg.errors.reading},
         "controller": r.controller,
         "J_A": r.average.J_A, "J_w": r.average.J_w, "J": r.average.J,
         "n_targets": len(r.targets),
@@ -134,9 +135,10 @@ def _save_npz(path: Path, arrays: dict) -> None:
             np.savez_compressed(fh, **arrays)
 
 
-def write_campaign(r: CampaignResult, out: Path) -> None:
+def write_campaign(r: CampaignResult, out: Path, scenario: dict | None = None) -> None:
+    """scenario: the scenario file's description (host.sim.scenario_file.Scenario.describe), recorded."""
     out = Path(out)
-    atomic.write_json(out / "metrics.json", metrics_document(r))
+    atomic.write_json(out / "metrics.json", metrics_document(r, scenario))
     if len(r.histories) == 1:
         _save_npz(out / "history.npz", r.histories[0].arrays())
     else:

@@ -85,9 +85,9 @@ def _name(key) -> str:
 
 # ----------------------------------------------------------------------------- readings
 
-def _source_values(constant: float, random: float, random_is: str, period: float) -> dict:
+def _source_values(constant: float, random: float, random_is: str, period: float, applies_to: str = "axis") -> dict:
     return {"constant": [constant] * 3, "random": [random] * 3, "random_is": random_is,
-            "random_applies_to": "axis", "noise_period_s": period}
+            "random_applies_to": applies_to, "noise_period_s": period}
 
 
 def _tables(star: dict, gyro: dict, wheels: dict) -> dict:
@@ -111,6 +111,49 @@ READINGS: dict[str, tuple[str, dict]] = {
     ),
 }
 DEFAULT_READING = "table6"
+
+# The calibration study's candidates (host.tune.calibrate, docs/scenario.md "Readings"): every
+# combination of one defensible reading per source. A "norm" reading takes Table 6's values as the
+# magnitude of the 3-axis error: the constant is split equally over the axes (value/√3 on each) and
+# the random value is k·σ of the RMS magnitude (σ per axis = value/(k·√3)).
+SQRT3 = math.sqrt(3.0)
+STAR_READINGS = {
+    "axis": ("star 3\" constant and 3\" (3σ) on each angle",
+             _source_values(3.0, 3.0, "3sigma", 0.1)),
+    "norm": ("star 3\" constant and 3\" (3σ) as the 3-axis magnitude",
+             _source_values(3.0 / SQRT3, 3.0, "3sigma", 0.1, "norm")),
+}
+GYRO_READINGS = {
+    "axis": ("gyro 0.15°/h constant and 0.15°/h (1σ) on each axis", _source_values(0.15, 0.15, "1sigma", 0.1)),
+    "norm": ("gyro 0.15°/h constant and 0.15°/h (1σ) as the 3-axis magnitude",
+             _source_values(0.15 / SQRT3, 0.15, "1sigma", 0.1, "norm")),
+}
+WHEEL_READINGS = {
+    "held": ("wheels 'nm' as N·m, 0.01 N·m (1σ) per wheel drawn each 0.1 s control period",
+             _source_values(0.01, 0.01, "1sigma", 0.1)),
+    "white": ("wheels 'nm' as N·m, 0.01 N·m (1σ) per wheel drawn each 0.02 s plant step",
+              _source_values(0.01, 0.01, "1sigma", 0.02)),
+    "norm": ("wheels 'nm' as N·m, 0.01 N·m (1σ) as the 3-wheel magnitude, drawn each control period",
+             _source_values(0.01 / SQRT3, 0.01, "1sigma", 0.1, "norm")),
+    "mnm": ("wheels 'nm' as mN·m: 1e-5 N·m constant and (1σ) per wheel, drawn each control period",
+            _source_values(1e-5, 1e-5, "1sigma", 0.1)),
+}
+
+
+def candidate_readings() -> dict[str, tuple[str, dict]]:
+    """name -> (description, tables) of every combination but table6's own (axis, axis, held)."""
+    out = {}
+    for s_name, (s_text, star) in STAR_READINGS.items():
+        for g_name, (g_text, gyro) in GYRO_READINGS.items():
+            for w_name, (w_text, wheels) in WHEEL_READINGS.items():
+                if (s_name, g_name, w_name) == ("axis", "axis", "held"):
+                    continue
+                out[f"{s_name}-star_{g_name}-gyro_{w_name}-wheels"] = (
+                    f"{s_text}; {g_text}; {w_text}", _tables(star=star, gyro=gyro, wheels=wheels))
+    return out
+
+
+READINGS.update(candidate_readings())
 
 
 # ----------------------------------------------------------------------------- validation

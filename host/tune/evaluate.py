@@ -50,6 +50,8 @@ STEP_AT = 30.0
 SETTLE_BAND = 0.05
 TORQUE_AMPLITUDE = 0.03
 ENGINES = ("batched", "scalar")
+# `--quick`: the small preset (CI, a first look); its numbers are not comparable with the paper's
+QUICK = {"targets": 3, "duration": 20.0, "response_targets": 1, "freqs": (0.1, 1.0), "freq_duration": 30.0}
 
 
 @dataclass(frozen=True)
@@ -144,6 +146,7 @@ class EvalPlan:
     k2: float = K2
     errors: ErrorModel = TABLE6_ERRORS
     engine: str = "batched"
+    preset: str = "paper"       # "paper" (100 targets × 100 s by default) or "quick"
 
     def config(self, duration: float, **extra) -> SimConfig:
         return SimConfig(duration=duration, seed=self.seed, errors=self.errors, **extra)
@@ -208,7 +211,7 @@ def _bar_callback(total: int, progress: bool, desc: str):
     return (lambda k: bar.update()), bar.close
 
 
-def _fly_bank(plan: EvalPlan, specs: list[ControllerSpec], targets: list[tuple[float, float]], streams: list[int],
+def fly_bank(plan: EvalPlan, specs: list[ControllerSpec], targets: list[tuple[float, float]], streams: list[int],
               cfg: SimConfig, progress: bool, desc: str, record: bool = False):
     """Every spec side by side in one batched run; the result's variant g is specs[g]."""
     bank = ControllerBank([s.batch(cfg.spacecraft.torque_limit, cfg.control_period) for s in specs])
@@ -234,7 +237,7 @@ def staring(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=
     batched, scalar = _split(plan, [s for s in specs if s.label not in known])
     rows = dict(known)
     if batched:
-        res = _fly_bank(plan, batched, [(lon, lat) for _, lon, lat, _ in plan.targets],
+        res = fly_bank(plan, batched, [(lon, lat) for _, lon, lat, _ in plan.targets],
                         [s for *_, s in plan.targets], cfg, progress, f"staring ({len(plan.targets)} targets)")
         for g, spec in enumerate(batched):
             rows[spec.label] = _row(res.J_A[:, g, 0], res.J_w[:, g, 0], plan)
@@ -291,7 +294,7 @@ def step_response(plan: EvalPlan, specs: list[ControllerSpec], workers=None, pro
         targets = [(lon, lat) for _, lon, lat, _ in plan.response_targets] * 2
         streams = [s for *_, s in plan.response_targets] * 2
         cfg = replace(base, attitude_offset=StepOffsetRows(2 * n, n, len(batched)))
-        res = _fly_bank(plan, batched, targets, streams, cfg, progress, f"step ({n} targets)", record=True)
+        res = fly_bank(plan, batched, targets, streams, cfg, progress, f"step ({n} targets)", record=True)
         for g, spec in enumerate(batched):
             out[spec.label] = _step_entry([(res.A_bd_deg[i, g, 0], res.A_bd_deg[n + i, g, 0]) for i in range(n)], t)
     stepped = replace(base, attitude_offset=StepOffset())
@@ -334,7 +337,7 @@ def frequency_response(plan: EvalPlan, specs: list[ControllerSpec], workers=None
     out = {}
     if batched:   # the central target once undisturbed and once per (axis, frequency)
         cfg = replace(base, extra_torque=SineTorqueRows(tuple(plan.freqs), len(batched)))
-        res = _fly_bank(plan, batched, [(lon, lat)] * copies, [stream] * copies, cfg, progress,
+        res = fly_bank(plan, batched, [(lon, lat)] * copies, [stream] * copies, cfg, progress,
                         f"frequency ({copies} runs)", record=True)
         for g, spec in enumerate(batched):
             hist = [res.A_bd_deg[c, g, 0] for c in range(copies)]
@@ -370,7 +373,7 @@ def evaluate(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress
                       "duration": plan.duration, "seed": plan.seed, "step_duration": plan.step_duration,
                       "freqs_hz": list(plan.freqs), "freq_duration": plan.freq_duration,
                       "freq_settle": plan.freq_settle, "k1": plan.k1, "k2": plan.k2, "engine": plan.engine,
-                      "error_reading": plan.errors.reading}
+                      "preset": plan.preset, "error_reading": plan.errors.reading}
     return result
 
 

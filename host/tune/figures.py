@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import atomic
+from host.plant.error_model import TABLE6_ERRORS, ErrorModel
 from host.sim import impulse, plots
 
 AXES = ("x", "y", "z")
@@ -64,10 +65,10 @@ def fig13_14_frequency(freq: dict, path: Path) -> Path:
     return plots._save(fig, path)
 
 
-def write_evaluation(result: dict, network: str, seed: int, out: Path) -> dict:
+def write_evaluation(result: dict, network: str, seed: int, out: Path, errors: ErrorModel = TABLE6_ERRORS) -> dict:
     """Add the impulse response of the network (Fig. 15) to `result`, then write evaluate.json and
     Figs. 10-15 into `out` (created). Returns `result`."""
-    imp = impulse.run("nn", network, seed=seed)
+    imp = impulse.run("nn", network, seed=seed, errors=errors)
     result["impulse"] = imp.as_dict()
     out.mkdir(parents=True, exist_ok=True)
     fig10_scatter(result["staring"], out / "fig10_scatter.png")

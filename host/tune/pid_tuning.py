@@ -38,6 +38,7 @@ from host.learn.samples import npz_bytes
 from host.learn.shards import check_place, read_bound_npz, read_json
 from host.sim.batched import GainSets, simulate_pid_batch
 from host.sim.metrics import K1, K2
+from host.plant.error_model import TABLE6_ERRORS, ErrorModel
 from host.sim.simulator import SimConfig
 from host.tune.pid_grid import PidGrid
 
@@ -57,6 +58,8 @@ class TuningPlan:
     shard_size: int = 60
     k1: float = K1
     k2: float = K2
+    errors: ErrorModel = TABLE6_ERRORS          # the scenario's reading of Table 6
+    scenario: dict | None = None                # its file's description (recorded, part of the plan's hash)
 
     def __post_init__(self):
         if not self.targets:
@@ -79,13 +82,14 @@ class TuningPlan:
         return {"format": PLAN_FORMAT, "grid": self.grid.as_dict(),
                 "targets": [{"name": n, "lon": lon, "lat": lat, "stream": s} for n, lon, lat, s in self.targets],
                 "seeds": list(self.seeds), "duration": self.duration, "shard_size": self.shard_size,
-                "k1": self.k1, "k2": self.k2, "sim": _sim_facts(SimConfig(duration=self.duration))}
+                "k1": self.k1, "k2": self.k2, "sim": _sim_facts(self.sim_config()),
+                "scenario": self.scenario or {"reading": self.errors.reading}}
 
     def plan_hash(self) -> str:
         return hashlib.sha256(json.dumps(self.as_dict(), sort_keys=True).encode()).hexdigest()
 
     def sim_config(self) -> SimConfig:
-        return SimConfig(duration=self.duration)
+        return SimConfig(duration=self.duration, errors=self.errors)
 
 
 def _sim_facts(cfg: SimConfig) -> dict:

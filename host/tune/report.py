@@ -18,17 +18,9 @@ from pathlib import Path
 
 from codegen import atomic
 from host.errors import HostError
+from host.tune import paper001
 
-# paper 001 (Li, Dong, Li 2020); Table 10's z steady-state error is printed 2.95e-4, but its
-# "average of three axes" 1.24e-5 is the mean of x, y and 2.95e-5: a misprint, we show 2.95e-5.
-PAPER_TABLE8 = {"PID": (3.96e-4, 4.23e-5, 6.07e-4), "NN": (2.13e-4, 3.81e-5, 4.03e-4)}
-PAPER_TABLE9 = {"PID": (3.96e-4, 4.25e-5, 6.09e-4), "NN": (2.13e-4, 3.76e-5, 4.01e-4)}
-PAPER_STEP = {   # overshoot %, settling s, steady-state error (deg), per axis x, y, z
-    "PID": {"overshoot_pct": (13.49, 0.97, 1.12), "settling_s": (10.33, 3.67, 8.06),
-            "steady_state_deg": (7.34e-6, 4.19e-7, 2.95e-5)},
-    "NN": {"overshoot_pct": (2.80, 0.001, 3.56), "settling_s": (3.07, 3.42, 2.99),
-           "steady_state_deg": (7.13e-6, 5.38e-8, 1.33e-5)},
-}
+PAPER_TABLE8, PAPER_TABLE9, PAPER_STEP = paper001.TABLE8, paper001.TABLE9, paper001.STEP
 STEP_NAMES = {"overshoot_pct": "overshoot [%]", "settling_s": "settling time [s]",
               "steady_state_deg": "steady-state error [°]"}
 
@@ -68,7 +60,7 @@ def _paper_key(label: str) -> str | None:
     return None
 
 
-def staring_blocks(rows: dict, paper: dict, title: str) -> list[Block]:
+def staring_blocks(rows: dict, paper: dict, title: str, quick: bool = False) -> list[Block]:
     body = []
     readings = []
     for label, r in rows.items():
@@ -85,14 +77,15 @@ def staring_blocks(rows: dict, paper: dict, title: str) -> list[Block]:
     if nn and pid:
         ratio = nn["J"] / pid["J"]
         verdict = "reproduced" if ratio < 1.0 else "not reproduced"
+        caveat = " (quick preset: not comparable with the paper's 100 targets × 100 s)" if quick else ""
         readings.append(f"NN / best PID J̄ = {ratio:.2f} (paper {paper['NN'][2] / paper['PID'][2]:.2f}): "
-                        f"the network beating the PID is {verdict}.")
+                        f"the network beating the PID is {verdict}{caveat}.")
     out += [Block("p", "Reading: " + r) for r in readings]
     return out
 
 
-def step_blocks(step: dict) -> list[Block]:
-    out = [Block("h2", "Step response (§7.6.1, Tables 10-11): mean over the response targets")]
+def step_blocks(step: dict, tag: str = "") -> list[Block]:
+    out = [Block("h2", "Step response (§7.6.1, Tables 10-11): mean over the response targets" + tag)]
     header = ("controller", "index", "x", "y", "z", "average", "paper x", "paper y", "paper z")
     body = []
     for label, s in step.items():
@@ -112,8 +105,8 @@ def step_blocks(step: dict) -> list[Block]:
     return out
 
 
-def frequency_blocks(freq: dict) -> list[Block]:
-    out = [Block("h2", "Frequency response (§7.7, Figs. 13-14): amplitude of A_bd [°] under a 0.03 N·m sine")]
+def frequency_blocks(freq: dict, tag: str = "") -> list[Block]:
+    out = [Block("h2", "Frequency response (§7.7, Figs. 13-14): amplitude of A_bd [°] under a 0.03 N·m sine" + tag)]
     labels = list(freq)
     if not labels:
         return out
@@ -134,7 +127,69 @@ def frequency_blocks(freq: dict) -> list[Block]:
     return out
 
 
-def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_facts: dict) -> list[Block]:
+def _scenario_tag(doc: dict | None) -> str:
+    """' — scenario NAME (sha256 …)' of an evaluate/calibrate/tune document, '' when not recorded."""
+    sc = (doc or {}).get("scenario") or {}
+    if not sc:
+        return ""
+    digest = sc.get("sha256")
+    return f" — scenario {sc.get('reading', '?')}" + (f" (sha256 {str(digest)[:16]}…)" if digest else "")
+
+
+def _fidelity_staring(evaluation: dict, cal: dict) -> list[Block]:
+    """Tables 8-9 under table6 (the evaluation, when it flew table6) and under the calibrated reading."""
+    labels = cal["labels"]
+    rows = []
+    for where, table, paper, title in (("central", "staring_central", PAPER_TABLE8, "Table 8"),
+                                       ("all", "staring", PAPER_TABLE9, "Table 9")):
+        for key, label in (("PID", labels["table1"]), ("NN", labels["network"])):
+            p = paper[key]
+            ev = evaluation.get(table, {}).get(label) if evaluation.get("plan", {}).get("error_reading") == "table6" else None
+            c = cal["prediction"]["staring"][label][where]
+            rows.append((title, label, _g(p[0]), _g(p[1]), _g(p[2]),
+                         _g(ev["J_A"]) if ev else "–", _g(ev["J_w"]) if ev else "–", _g(ev["J"]) if ev else "–",
+                         _g(c["J_A"]), _g(c["J_w"]), _g(c["J"])))
+    header = ("table", "controller", "paper J_A", "paper J_ω", "paper J̄", "table6 J_A", "table6 J_ω", "table6 J̄",
+              "calibrated J_A", "calibrated J_ω", "calibrated J̄")
+    return [Block("table", header=header, rows=tuple(rows))]
+
+
+def fidelity_blocks(evaluation: dict, cal: dict, figure: Path | None) -> list[Block]:
+    """The "Fidelity to paper 001" section from a calibration document (host.tune.calibrate)."""
+    labels = cal["labels"]
+    out = [Block("h2", "Fidelity to paper 001" + _scenario_tag({"scenario": cal.get("chosen_scenario")})),
+           Block("p", "Table 6's errors are ambiguous (which σ, per axis or 3-axis magnitude, the wheel unit 'nm', "
+                      "per-sample or held noise). Each candidate reading flew the Table 1 PID only; the residual is the "
+                      "RMS of ln(ours/paper) over the PID's J_A and J_ω of Tables 8 and 9. The network was not used "
+                      "to choose: its rows below are predictions.")]
+    body = tuple((c["reading"], _g(c["residual"]), *(_g(v) for v in c["ratios"].values())) for c in cal["candidates"])
+    first = cal["candidates"][0]["ratios"] if cal["candidates"] else {}
+    out.append(Block("table", header=("reading", "residual", *(f"{k} ours/paper" for k in first)), rows=body))
+    out.append(Block("p", f"Chosen reading: {cal['chosen']} (smallest residual, "
+                          f"{_g(cal['candidates'][0]['residual'])})."))
+    out += _fidelity_staring(evaluation, cal)
+    for label, r in cal["nn_to_pid_ratio"].items():
+        out.append(Block("p", f"Reading: predicted NN / {label} J̄ over the targets = {r:.2f} under the chosen reading "
+                              f"(paper {cal['paper_nn_to_pid_ratio']:.2f})."))
+    step = cal["prediction"].get("step", {})
+    rows = []
+    for label, mean in step.items():
+        key = "NN" if label == labels["network"] else ("PID" if label == labels["table1"] else None)
+        for k, name in STEP_NAMES.items():
+            p = PAPER_STEP[key][k] if key else ("", "", "")
+            rows.append((label, name, *(_g(x) for x in mean[k]), *(_g(x) if key else "" for x in p)))
+    if rows:
+        out += [Block("p", "Step response under the chosen reading beside Tables 10-11 (mean over the response targets):"),
+                Block("table", header=("controller", "index", "x", "y", "z", "paper x", "paper y", "paper z"),
+                      rows=tuple(rows))]
+    if figure is not None:
+        out.append(Block("img", text="NN / PID J̄ against a scale on every random error (paper's ratio marked)",
+                         path=str(figure)))
+    return out
+
+
+def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_facts: dict,
+          calibration: dict | None = None, calibration_figure: Path | None = None) -> list[Block]:
     blocks = [Block("h1", "staregen: tuning and evaluation against paper 001 §7")]
     facts = ", ".join(f"{k} {v}" for k, v in run_facts.items())
     blocks.append(Block("p", f"Run: {facts}."))
@@ -143,7 +198,10 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
         blocks.append(Block("p", f"Evaluation plan: {plan['targets']} staring targets × {plan['duration']:g} s, step "
                                  f"response over {plan['response_targets']} target(s), frequencies "
                                  f"{', '.join(_g(f) for f in plan['freqs_hz'])} Hz, noise seed {plan['seed']}."))
-        if plan["targets"] < 100 or plan["duration"] < 100:
+        if plan.get("preset") == "quick":
+            blocks.append(Block("p", "QUICK PRESET (--quick): 3 targets × 20 s; its numbers are not comparable "
+                                     "with the paper's Tables 8-11."))
+        elif plan["targets"] < 100 or plan["duration"] < 100:
             blocks.append(Block("p", "A reduced run: the paper's Tables 8-9 come from 100 targets × 100 s, and a "
                                      "short run weighs the first seconds of imaging (transients, the integral "
                                      "term) more; `staregen evaluate --targets all` is the comparable run "
@@ -160,11 +218,15 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
                               f"{_g(tuning['check']['table1']['J'])}, tuned {_g(tuning['check']['tuned']['J'])} "
                               f"(ratio {tuning['check']['ratio_tuned_to_table1']:.3f}); paper Table 1: Kp 17/54/18, "
                               f"Ki 0/0/0, Kd 46/77/50.")]
+    tag = _scenario_tag(evaluation)
+    quick = (plan or {}).get("preset") == "quick"
     if "staring_central" in evaluation:
-        blocks += staring_blocks(evaluation["staring_central"], PAPER_TABLE8, "Central target (Table 8)")
-    blocks += staring_blocks(evaluation["staring"], PAPER_TABLE9, "All staring targets (Table 9)")
-    blocks += step_blocks(evaluation["step"])
-    blocks += frequency_blocks(evaluation["frequency"])
+        blocks += staring_blocks(evaluation["staring_central"], PAPER_TABLE8, "Central target (Table 8)" + tag, quick)
+    blocks += staring_blocks(evaluation["staring"], PAPER_TABLE9, "All staring targets (Table 9)" + tag, quick)
+    blocks += step_blocks(evaluation["step"], tag)
+    blocks += frequency_blocks(evaluation["frequency"], tag)
+    if calibration:
+        blocks += fidelity_blocks(evaluation, calibration, calibration_figure)
     imp = evaluation.get("impulse")
     if imp:
         blocks += [Block("h2", "Impulse response (§7.8, Fig. 15)"),
@@ -183,21 +245,26 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
     return blocks
 
 
+def _md(text) -> str:
+    """Text for Markdown: HTML special characters as entities (a renderer passes raw HTML through)."""
+    return html.escape(str(text), quote=False)
+
+
 def to_markdown(blocks: list[Block]) -> str:
     out = []
     for b in blocks:
         if b.kind == "h1":
-            out.append(f"# {b.text}\n")
+            out.append(f"# {_md(b.text)}\n")
         elif b.kind == "h2":
-            out.append(f"## {b.text}\n")
+            out.append(f"## {_md(b.text)}\n")
         elif b.kind == "p":
-            out.append(b.text + "\n")
+            out.append(_md(b.text) + "\n")
         elif b.kind == "table":
-            cells = [[str(c).replace("|", "\\|") for c in row] for row in (b.header, *b.rows)]
+            cells = [[_md(c).replace("|", "\\|") for c in row] for row in (b.header, *b.rows)]
             out.append("| " + " | ".join(cells[0]) + " |\n|" + "---|" * len(cells[0]) + "\n"
                        + "".join("| " + " | ".join(r) + " |\n" for r in cells[1:]))
         elif b.kind == "img":
-            out.append(f"![{b.text}]({Path(b.path).name})\n")
+            out.append(f"![{_md(b.text)}]({Path(b.path).name})\n")
     return "\n".join(out)
 
 
@@ -224,7 +291,23 @@ def to_html(blocks: list[Block]) -> str:
             f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n")
 
 
-def write_report(out: Path, evaluate_dir: Path, tune_dir: Path | None, commands: list[str]) -> dict[str, Path]:
+def _copy_figure(src: Path, dst: Path) -> Path:
+    if src.resolve() != dst.resolve():
+        with atomic.writing(dst, suffix=".png") as tmp:
+            shutil.copyfile(src, tmp)
+    return dst
+
+
+def _read_calibration(folder: Path) -> dict:
+    doc = _read(folder / "calibration.json", "calibration (calibration.json)")
+    keys = {"candidates", "chosen", "prediction", "labels", "nn_to_pid_ratio", "paper_nn_to_pid_ratio"}
+    if not isinstance(doc, dict) or not keys <= set(doc):
+        raise HostError(f"{folder / 'calibration.json'}: not written by `staregen calibrate`")
+    return doc
+
+
+def write_report(out: Path, evaluate_dir: Path, tune_dir: Path | None, commands: list[str],
+                 calibration_dir: Path | None = None) -> dict[str, Path]:
     evaluation = _read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)")
     if not isinstance(evaluation, dict) or not {"staring", "step", "frequency"} <= set(evaluation):
         raise HostError(f"{evaluate_dir / 'evaluate.json'}: not written by `staregen evaluate`")
@@ -234,11 +317,12 @@ def write_report(out: Path, evaluate_dir: Path, tune_dir: Path | None, commands:
     for name in ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png"):
         src = evaluate_dir / name
         if src.is_file():
-            dst = out / name
-            if src.resolve() != dst.resolve():
-                with atomic.writing(dst, suffix=".png") as tmp:
-                    shutil.copyfile(src, tmp)
-            figures[name] = dst
+            figures[name] = _copy_figure(src, out / name)
+    calibration, cal_figure = None, None
+    if calibration_dir is not None:
+        calibration = _read_calibration(calibration_dir)
+        if (calibration_dir / "fig_ratio_vs_noise.png").is_file():
+            cal_figure = _copy_figure(calibration_dir / "fig_ratio_vs_noise.png", out / "fig_ratio_vs_noise.png")
     facts = {"date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
              "machine": f"{platform.machine()} {platform.system()} {platform.release()}, Python {platform.python_version()}",
              "evaluation wall times [s]": json.dumps(evaluation.get("timing", {}))}
@@ -246,7 +330,7 @@ def write_report(out: Path, evaluate_dir: Path, tune_dir: Path | None, commands:
         facts["tuning wall time [s]"] = tuning.get("timing", {}).get("wall_seconds")
     if commands:
         facts["commands"] = "; ".join(commands)
-    blocks = build(evaluation, tuning, figures, facts)
+    blocks = build(evaluation, tuning, figures, facts, calibration, cal_figure)
     paths = {"md": atomic.write_text(out / "report.md", to_markdown(blocks)),
              "html": atomic.write_text(out / "report.html", to_html(blocks))}
     return paths

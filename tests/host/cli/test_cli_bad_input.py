@@ -13,6 +13,7 @@ from codegen.artifact import random_artifact
 from host.cli import build_parser, main
 from host.control.nn_controller import CONFIG_SOURCES, default_package_config
 from codegen.package import config as pc
+from host.sim import scenario_file
 
 CASES = [
     # argparse itself: one line, not the usage block
@@ -149,7 +150,38 @@ CASES = [
     (["evaluate", "--network", "{net}", "--controllers", "nn-arm", "--out", "{tmp}/e"], "not available"),
     (["report", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"], "not a folder"),
     (["report", "--evaluate", "{dir}", "--out", "{tmp}/r"], "evaluate.json"),
+    (["report", "--evaluate", "{dir}", "--calibration", "{tmp}/none", "--out", "{tmp}/r"], "not a folder"),
+    # scenario files (issue 24): wrong types, negative σ, unknown keys, NaN, a file that is not TOML
+    (["evaluate", "--network", "{net}", "--scenario", "{scen_nan}", "--out", "{tmp}/e"], "must be finite"),
+    (["evaluate", "--network", "{net}", "--scenario", "{scen_negative}", "--out", "{tmp}/e"], "must not be negative"),
+    (["simulate", "--scenario", "{scen_unknown}", "--out", "{tmp}/o"], "unknown key"),
+    (["simulate", "--scenario", "{scen_type}", "--out", "{tmp}/o"], "must be a number"),
+    (["tune", "pid", "--scenario", "{net}", "--out", "{tmp}/t"], "TOML"),
+    (["tune", "pid", "--scenario", "{tmp}/none.toml", "--out", "{tmp}/t"], "none.toml"),
+    (["evaluate", "--network", "{net}", "--quick", "--engine", "warp", "--out", "{tmp}/e"], "invalid choice"),
+    (["scenario", "check", "{scen_nan}"], "must be finite"),
+    (["calibrate", "--network", "{small}", "--out", "{tmp}/c"], "12-input"),
+    (["calibrate", "--network", "{net}", "--readings", "table7", "--out", "{tmp}/c"], "unknown reading"),
+    (["calibrate", "--network", "{net}", "--scales", "-1", "--out", "{tmp}/c"], "--scales"),
+    (["calibrate", "--network", "{net}", "--targets", "3", "--response-targets", "5", "--out", "{tmp}/c"],
+     "--response-targets"),
 ]
+
+
+def _bad_scenarios(folder) -> dict[str, str]:
+    """Scenario files with one defect each (edited from a valid, sealed one: the value check comes first)."""
+    good = scenario_file.to_toml(scenario_file.default_scenario())
+    edits = {"scen_nan": ("random_arcsec = [3.0, 3.0, 3.0]", "random_arcsec = [nan, 3.0, 3.0]"),
+             "scen_negative": ("random_deg_per_h = [0.15, 0.15, 0.15]", "random_deg_per_h = [-0.15, 0.15, 0.15]"),
+             "scen_unknown": ("[wheels]", "[wheels]\nspin = 1"),
+             "scen_type": ("constant_Nm = [0.01, 0.01, 0.01]", "constant_Nm = [\"0.01\", 0.01, 0.01]")}
+    out = {}
+    for name, (old, new) in edits.items():
+        assert old in good, old
+        path = folder / f"{name}.toml"
+        path.write_text(good.replace(old, new))
+        out[name] = str(path)
+    return out
 
 
 @pytest.fixture()
@@ -163,7 +195,7 @@ def places(tmp_path, monkeypatch):
     np.save(tmp_path / "x0.npy", np.zeros((0, 12), np.float32))
     pc.write(default_package_config(), tmp_path / "controller.toml", CONFIG_SOURCES)
     (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
-    return {"tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
+    return {**_bad_scenarios(tmp_path), "tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
             "file": str(tmp_path / "file.txt"), "dir": str(tmp_path / "folder"), "x": str(tmp_path / "x.npy"),
             "x0": str(tmp_path / "x0.npy"), "cfg": str(tmp_path / "controller.toml"), "deep": str(tmp_path / "deep.json")}
 

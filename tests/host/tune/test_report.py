@@ -112,3 +112,42 @@ def test_report_of_a_real_evaluation_holds_every_table_and_figure(tmp_path, arti
     md = (out / "report.md").read_text()
     assert md.count("\n|---|") == 4 and md.count("![") == len(figs)
     assert "Evaluation plan: 1 staring targets × 12 s" in md and "A reduced run" in md
+
+
+def _calibration(hostile: str) -> dict:
+    pid = {w: {"J_A": 5e-4, "J_w": 5e-5, "J": 7.5e-4} for w in ("central", "all")}
+    nn = {w: {"J_A": 3e-4, "J_w": 4e-5, "J": 5e-4} for w in ("central", "all")}
+    mean = {"overshoot_pct": [1, 2, 3], "settling_s": [4, 5, 6], "steady_state_deg": [1e-5, 2e-5, 3e-5]}
+    return {"labels": {"table1": "PID (Table 1)", "tuned": None, "network": "NN (float64)"},
+            "candidates": [{"reading": hostile, "residual": 0.25, "pid": pid,
+                            "ratios": {"central J_A": 1.26, "central J_w": 1.18, "all J_A": 1.26, "all J_w": 1.18}}],
+            "chosen": hostile, "chosen_scenario": {"reading": hostile, "sha256": "ab" * 32},
+            "prediction": {"staring": {"PID (Table 1)": pid, "NN (float64)": nn},
+                           "step": {"PID (Table 1)": mean, "NN (float64)": mean}},
+            "nn_to_pid_ratio": {"PID (Table 1)": 0.6667}, "paper_nn_to_pid_ratio": 0.658}
+
+
+def test_the_fidelity_section_holds_the_calibration_escaped(tmp_path):
+    ev, cal = tmp_path / "ev", tmp_path / "cal"
+    ev.mkdir()
+    cal.mkdir()
+    doc = _evaluation("PD+FF")
+    doc["plan"] = {"targets": 100, "duration": 100.0, "response_targets": 100, "freqs_hz": [1.0], "seed": 0,
+                   "error_reading": "table6", "preset": "paper"}
+    doc["scenario"] = {"reading": "table6", "sha256": "cd" * 32}
+    (ev / "evaluate.json").write_text(json.dumps(doc))
+    hostile = "<img src=x onerror=alert(1)>|x"
+    (cal / "calibration.json").write_text(json.dumps(_calibration(hostile)))
+    assert main(["report", "--evaluate", str(ev), "--calibration", str(cal), "--out", str(tmp_path / "r")]) == 0
+    md = (tmp_path / "r" / "report.md").read_text()
+    assert "## Fidelity to paper 001" in md and "Chosen reading:" in md
+    assert "predicted NN / PID (Table 1) J̄ over the targets = 0.67" in md and "(paper 0.66)" in md
+    assert md.count("scenario table6 (sha256 cdcdcdcdcdcdcdcd…)") == 4       # Tables 8, 9, step, frequency
+    assert "<img" not in md and "&lt;img src=x onerror=alert(1)&gt;" in md
+    text = (tmp_path / "r" / "report.html").read_text()
+    assert "<img src=x" not in text and "&lt;img src=x onerror=alert(1)&gt;" in text
+    p = Collect()
+    p.feed(text)
+    assert "5e-04" not in p.cells and _g(5e-4) in p.cells and _g(PAPER_TABLE9["NN"][2]) in p.cells
+    (cal / "calibration.json").write_text("{}")
+    assert main(["report", "--evaluate", str(ev), "--calibration", str(cal), "--out", str(tmp_path / "r2")]) == 2
