@@ -62,14 +62,13 @@ class GeneratedLaw:
 
 
 class Float64LawRows:
-    """Float64Law on rows (the law is a search and a fit per query: one query per row)."""
+    """Float64Law on rows (DpModel.query_rows: the same results as one query per row)."""
 
     def __init__(self, t: dp_tables.DpTables):
-        self.one = Float64Law(t)
+        self.model = Float64Law(t).model
 
     def __call__(self, x_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        results = [self.one(x) for x in x_deg]
-        return np.array([r[0] for r in results]).reshape(-1, 3), np.array([r[1] for r in results], bool)
+        return self.model.query_rows(x_deg)
 
 
 class GeneratedLawRows:
