@@ -60,10 +60,14 @@ class ErrorSource:
         """The random part times `factor` (the constant part unchanged)."""
         return replace(self, sigma=tuple(float(s) * factor for s in self.sigma))
 
+    def draw_index(self, times: np.ndarray) -> np.ndarray:
+        """Which draw holds at each sample time: floor(t / period) (a boundary sample takes the later)."""
+        return np.floor(np.asarray(times, float) / self.period + DRAW_TOLERANCE).astype(np.int64)
+
     def draws(self, rng: np.random.Generator, times: np.ndarray) -> np.ndarray:
         """(len(times), 3) noise at the sample times: draw i = floor(t / period), one
         rng.normal(0, σ, (n, 3)) call for the draws the times need."""
-        index = np.floor(np.asarray(times, float) / self.period + DRAW_TOLERANCE).astype(np.int64)
+        index = self.draw_index(times)
         n = int(index[-1]) + 1 if index.size else 0
         values = rng.normal(0.0, self.sigma_array, (n, 3))
         return values[index]
@@ -99,12 +103,17 @@ def noise_generators(seed: int, stream: int) -> tuple[np.random.Generator, ...]:
     return tuple(np.random.default_rng(s) for s in np.random.SeedSequence([seed, stream]).spawn(3))
 
 
+def plant_times(n_ctrl: int, control_period: float, substeps: int) -> np.ndarray:
+    """The plant-step instants of a run of n_ctrl control periods (where the wheel error is drawn)."""
+    return np.arange(n_ctrl * substeps) * (control_period / substeps)
+
+
 def draw_noise(model: ErrorModel, seed: int, stream: int, n_ctrl: int, control_period: float, substeps: int,
                sensors: bool = True, wheels: bool = True) -> NoiseTrack:
     """The noise of (seed, stream) for a run of n_ctrl control periods of `substeps` plant steps."""
     g_star, g_gyro, g_wheel = noise_generators(seed, stream)
     t_ctrl = np.arange(n_ctrl) * control_period
-    t_plant = np.arange(n_ctrl * substeps) * (control_period / substeps)
+    t_plant = plant_times(n_ctrl, control_period, substeps)
     zeros_ctrl, zeros_plant = np.zeros((n_ctrl, 3)), np.zeros((n_ctrl * substeps, 3))
     return NoiseTrack(star=model.star.draws(g_star, t_ctrl) if sensors else zeros_ctrl,
                       gyro=model.gyro.draws(g_gyro, t_ctrl) if sensors else zeros_ctrl,

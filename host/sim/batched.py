@@ -38,6 +38,7 @@ from host.control.pid import GainSets, PidBatch
 from host.core.constants import DEG
 from host.errors import HostError
 from host.gnc.guidance import desired_state
+from host.plant.error_model import plant_times
 from host.sim import batch_plant as bp
 from host.sim.metrics import DEFAULT_PLAN, K1, K2, ImagingPlan, window_samples
 from host.sim.simulator import SimConfig, environment_track, initial_state, run_noise
@@ -174,6 +175,8 @@ class _Loop:
         errors = cfg.errors
         self.star_bias, self.gyro_bias, self.wheel_bias = (
             s.bias_array[:, None, None] for s in (errors.star, errors.gyro, errors.wheels))
+        # the wheel error's draw index at each plant step (error_model.ErrorSource.draws' rule)
+        self.wheel_draw = errors.wheels.draw_index(plant_times(self.n_ctrl, cfg.control_period, self.sub))
         self.x = np.ascontiguousarray(np.broadcast_to(self.tg.x0, (10, T, B)))
         self.sum_A, self.sum_w = np.zeros((3, T, B)), np.zeros((3, T, B))
         self.saturated_steps = np.zeros(T * B, dtype=np.int64)
@@ -222,7 +225,8 @@ class _Loop:
             if j != j0:
                 L_bi = bp.dcm_from_quat(self.x[0:4])
             self.accumulate(j, L_bi)
-            M_c = (M_sat + self.wheel_bias) + self.noise.wheels_at(j) if cfg.wheel_errors else M_sat
+            if j == j0 or self.wheel_draw[j] != self.wheel_draw[j - 1]:   # a held draw: the same torque
+                M_c = (M_sat + self.wheel_bias) + self.noise.wheels_at(j) if cfg.wheel_errors else M_sat
             M_ext = self.plant.external_torque(j, L_bi) if cfg.external_torques else self.no_torque
             if cfg.extra_torque is not None:
                 M_ext = M_ext + _broadcast_input(cfg.extra_torque(self.env.t[j]), self.T, self.B)

@@ -350,25 +350,54 @@ def frequency_response(plan: EvalPlan, specs: list[ControllerSpec], workers=None
     return {s.label: out[s.label] for s in specs}
 
 
+def staring_tables(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True) -> dict:
+    """Tables 8 and 9: {"staring_central": rows, "staring": rows}. Batched, the central target flies in
+    the same run as the targets; the PIL run flies the central target only, so its row of the central
+    table is its row of the targets' table too."""
+    batched, scalar = _split(plan, specs)
+    central_plan = replace(plan, targets=(plan.central,))
+    rows_c, rows_t = {}, {}
+    if batched:
+        both = replace(plan, targets=(plan.central,) + tuple(plan.targets))
+        res = fly_bank(both, batched, [(lon, lat) for _, lon, lat, _ in both.targets], [s for *_, s in both.targets],
+                       plan.config(plan.duration), progress, f"staring (central + {len(plan.targets)} targets)")
+        for g, spec in enumerate(batched):
+            rows_c[spec.label] = _row(res.J_A[:1, g, 0], res.J_w[:1, g, 0], plan)
+            rows_t[spec.label] = _row(res.J_A[1:, g, 0], res.J_w[1:, g, 0], plan)
+    if scalar:
+        rows_c.update(staring(central_plan, scalar, workers, progress))
+        rows_t.update(staring(plan, scalar, workers, progress,
+                              known={s.label: rows_c[s.label] for s in scalar if s.name == "nn-arm"}))
+    return {"staring": {s.label: rows_t[s.label] for s in specs},
+            "staring_central": {s.label: rows_c[s.label] for s in specs}}
+
+
+EXPERIMENTS = {"staring": staring_tables, "step": step_response, "frequency": frequency_response}
+
+
+def _experiment(name: str, plan: EvalPlan, specs: list[ControllerSpec], workers, progress) -> tuple[dict, float]:
+    t0 = time.perf_counter()
+    return EXPERIMENTS[name](plan, specs, workers, progress), round(time.perf_counter() - t0, 2)
+
+
+def _run_experiments(plan: EvalPlan, specs: list[ControllerSpec], workers, progress) -> dict[str, tuple]:
+    """The three experiments; batched, each in its own process (up to `workers`, default every core):
+    a batched run uses one core, and the experiments are independent."""
+    n = max(1, min(workers or os.cpu_count() or 1, len(EXPERIMENTS)))
+    if plan.engine != "batched" or n == 1:
+        return {name: _experiment(name, plan, specs, workers, progress) for name in EXPERIMENTS}
+    with ProcessPoolExecutor(max_workers=n, mp_context=get_context("spawn")) as pool:
+        futures = {name: pool.submit(_experiment, name, plan, specs, 1, progress) for name in EXPERIMENTS}
+        return {name: fut.result() for name, fut in futures.items()}
+
+
 def evaluate(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True) -> dict:
     labels = [s.label for s in specs]
     if len(set(labels)) != len(labels):
         raise HostError(f"controllers listed twice: {labels}")
-    times = {}
-    t0 = time.perf_counter()
-    central = staring(replace(plan, targets=(plan.central,)), specs, workers, progress)
-    # the PIL run flies the central target only: its row of the central table is its row here too
-    result = {"staring": staring(plan, specs, workers, progress,
-                                 known={s.label: central[s.label] for s in specs if s.name == "nn-arm"}),
-              "staring_central": central}
-    times["staring_s"] = round(time.perf_counter() - t0, 2)
-    t0 = time.perf_counter()
-    result["step"] = step_response(plan, specs, workers, progress)
-    times["step_s"] = round(time.perf_counter() - t0, 2)
-    t0 = time.perf_counter()
-    result["frequency"] = frequency_response(plan, specs, workers, progress)
-    times["frequency_s"] = round(time.perf_counter() - t0, 2)
-    result["timing"] = times
+    done = _run_experiments(plan, specs, workers, progress)
+    result = {**done["staring"][0], "step": done["step"][0], "frequency": done["frequency"][0]}
+    result["timing"] = {f"{name}_s": seconds for name, (_, seconds) in done.items()}
     result["plan"] = {"targets": len(plan.targets), "response_targets": len(plan.response_targets),
                       "duration": plan.duration, "seed": plan.seed, "step_duration": plan.step_duration,
                       "freqs_hz": list(plan.freqs), "freq_duration": plan.freq_duration,
