@@ -15,7 +15,9 @@ from codegen import artifact as art
 from codegen.package import config as pc
 from host.cli.args import parse_int, parse_number
 from host.cli.tune import parse_targets
+from host.control.baselines import load_baselines
 from host.errors import HostError
+from host.learn.training import baselines_path
 from host.sim import scenario_file
 from host.sim.targets import central_target
 from host.tune import calibrate as cal
@@ -74,8 +76,10 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise HostError(f"output folder {out} exists and is not a directory")
+    laws = baselines_path(args.network)
+    pdff = load_baselines(laws)[1].coef if laws.exists() else None
     doc = cal.calibrate(plan, table1_spec(), ControllerSpec("NN (float64)", "nn", (("artifact", args.network),)), tuned,
-                        progress=not args.no_progress)
+                        progress=not args.no_progress, network_pdff=pdff)
     doc["network"] = {"file": str(args.network), "payload_sha256": a.sha256}
     cal.write(doc, out)
     print("\n".join(cal.summary_lines(doc)))

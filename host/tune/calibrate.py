@@ -26,8 +26,10 @@ import numpy as np
 from codegen import atomic
 from host.errors import HostError
 from host.sim import plots, scenario_file
+from host.plant.spacecraft import TABLE6
 from host.tune import paper001
 from host.tune.evaluate import ControllerSpec, EvalPlan, fly_bank, step_response
+from host.tune.step_model import gains_for_settling, pdff_gains, predicted_step
 
 PID_FIGURES = (("central", "J_A", paper001.TABLE8["PID"][0]), ("central", "J_w", paper001.TABLE8["PID"][1]),
                ("all", "J_A", paper001.TABLE9["PID"][0]), ("all", "J_w", paper001.TABLE9["PID"][1]))
@@ -112,8 +114,30 @@ def noise_sweep(plan: CalibrationPlan, errors, specs: list[ControllerSpec], prog
     return out
 
 
+def step_model(specs: list[ControllerSpec], network: ControllerSpec, network_pdff) -> dict:
+    """The per-axis PD model's step metrics (host.tune.step_model) of every PID and of the network's
+    fitted PD + feed-forward law, and the gains a law would need to settle in the paper's ~3 s."""
+    inertia = np.diag(TABLE6.inertia)
+    out = {}
+    for spec in specs:
+        if spec.gains is not None:
+            kp, kd = spec.gains.kp, spec.gains.kd
+        elif spec is network and network_pdff is not None:
+            kp, kd = pdff_gains(network_pdff)
+        else:
+            continue
+        out[spec.label] = {"kp": [float(v) for v in kp], "kd": [float(v) for v in kd],
+                           **predicted_step(kp, kd, inertia)}
+    paper_nn = paper001.STEP["NN"]["settling_s"]
+    need = [gains_for_settling(paper_nn[a], inertia[a]) for a in range(3)]
+    return {"laws": out, "critically_damped_for_paper_nn_settling": {
+        "settling_s": list(paper_nn), "kp": [k for k, _ in need], "kd": [d for _, d in need]}}
+
+
 def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: ControllerSpec,
-              tuned: ControllerSpec | None = None, progress: bool = True) -> dict:
+              tuned: ControllerSpec | None = None, progress: bool = True, network_pdff=None) -> dict:
+    """network_pdff: the network's fitted PD + feed-forward coefficients (its baselines file), for the
+    step model; None leaves the network out of it."""
     times = {}
     t0 = time.perf_counter()
     candidates = fit_pid(plan, table1, progress)
@@ -136,7 +160,7 @@ def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: Controller
             "candidates": sorted(candidates, key=lambda c: c["residual"]), "chosen": chosen["reading"],
             "chosen_scenario": scenario.describe(), "prediction": prediction,
             "nn_to_pid_ratio": ratios, "paper_nn_to_pid_ratio": paper001.NN_TO_PID_RATIO,
-            "noise_sweep": sweep, "timing": times}
+            "noise_sweep": sweep, "step_model": step_model(specs, network, network_pdff), "timing": times}
 
 
 # ----------------------------------------------------------------------------- files

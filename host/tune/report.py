@@ -154,6 +154,28 @@ def _fidelity_staring(evaluation: dict, cal: dict) -> list[Block]:
     return [Block("table", header=header, rows=tuple(rows))]
 
 
+def _step_model_blocks(model: dict | None, measured: dict) -> list[Block]:
+    """What sets the step response: the per-axis PD model of each law against the measured settling."""
+    if not model or not model.get("laws"):
+        return []
+    rows = []
+    for label, m in model["laws"].items():
+        got = measured.get(label, {}).get("settling_s")
+        rows.append((label, *(_g(v) for v in m["kp"]), *(_g(v) for v in m["kd"]), *(_g(v) for v in m["settling_s"]),
+                     *((_g(v) for v in got) if got else ("–",) * 3)))
+    need = model["critically_damped_for_paper_nn_settling"]
+    return [Block("p", "What sets the step response: a rigid body per axis under each law's PD gains with a 0.1 s "
+                       "zero-order hold (host/tune/step_model.py; the network's gains from its fitted PD + feed-forward "
+                       "law) predicts the 5 % settling time; where model and measurement agree the gains set it, not "
+                       "the noise."),
+            Block("table", header=("law", "Kp x", "Kp y", "Kp z", "Kd x", "Kd y", "Kd z", "model settling x [s]",
+                                   "y", "z", "measured x", "y", "z"), rows=tuple(rows)),
+            Block("p", "A critically damped law settling in the paper's NN times "
+                       f"({', '.join(_g(v) for v in need['settling_s'])} s) needs Kp "
+                       f"{', '.join(_g(v) for v in need['kp'])} N·m/° and Kd {', '.join(_g(v) for v in need['kd'])} "
+                       "N·m/(°/s) on x, y, z.")]
+
+
 def fidelity_blocks(evaluation: dict, cal: dict, figure: Path | None) -> list[Block]:
     """The "Fidelity to paper 001" section from a calibration document (host.tune.calibrate)."""
     labels = cal["labels"]
@@ -182,6 +204,7 @@ def fidelity_blocks(evaluation: dict, cal: dict, figure: Path | None) -> list[Bl
         out += [Block("p", "Step response under the chosen reading beside Tables 10-11 (mean over the response targets):"),
                 Block("table", header=("controller", "index", "x", "y", "z", "paper x", "paper y", "paper z"),
                       rows=tuple(rows))]
+    out += _step_model_blocks(cal.get("step_model"), step)
     if figure is not None:
         out.append(Block("img", text="NN / PID J̄ against a scale on every random error (paper's ratio marked)",
                          path=str(figure)))
