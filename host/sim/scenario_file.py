@@ -122,6 +122,8 @@ STAR_READINGS = {
              _source_values(3.0, 3.0, "3sigma", 0.1)),
     "norm": ("star 3\" constant and 3\" (3σ) as the 3-axis magnitude",
              _source_values(3.0 / SQRT3, 3.0, "3sigma", 0.1, "norm")),
+    "rnorm": ("star 3\" constant on each angle, 3\" (3σ) random as the 3-axis magnitude",
+              _source_values(3.0, 3.0, "3sigma", 0.1, "norm")),
 }
 GYRO_READINGS = {
     "axis": ("gyro 0.15°/h constant and 0.15°/h (1σ) on each axis", _source_values(0.15, 0.15, "1sigma", 0.1)),
