@@ -39,7 +39,7 @@ def parse_number(text: str, what: str, *, positive: bool = False, non_negative: 
 
 
 SCENARIO_HELP = ("scenario file (`staregen scenario init`): the reading of Table 6's sensor and wheel errors "
-                 "(default: the built-in `table6` reading)")
+                 f"(default: the built-in `{scenario_file.DEFAULT_READING}` reading, chosen by `staregen calibrate`)")
 
 
 def add_scenario_argument(parser) -> None:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from host.cli.args import parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.cli.simulate import check_output_folder, controller_options
 from host.control.controllers import CONTROLLERS
 from host.errors import HostError
@@ -24,6 +24,7 @@ def register(subparsers) -> None:
                    help="model artifact (network controllers); default: the stand-in network")
     p.add_argument("--duration", default="60", help="simulated seconds (default 60, at least 31)")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
+    add_scenario_argument(p)
     p.add_argument("--out", default="out/impulse", help="output folder (default out/impulse)")
     p.set_defaults(func=main)
 
@@ -40,10 +41,11 @@ def main(args: argparse.Namespace) -> int:
     options = controller_options(args)
     out = Path(args.out)
     check_output_folder(out, marker="impulse.json")
-    r = impulse.run(args.controller, options.get("artifact"), duration, parse_int(args.seed, "--seed"))
+    scenario = load_scenario(args.scenario)
+    r = impulse.run(args.controller, options.get("artifact"), duration, parse_int(args.seed, "--seed"), scenario.errors)
     try:
         with atomic.directory(out) as tmp:
-            impulse.write(r, tmp, args.controller)
+            impulse.write(r, tmp, args.controller, scenario.describe())
     except OSError as exc:
         raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
     d = r.as_dict()

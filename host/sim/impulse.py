@@ -103,7 +103,8 @@ def plot(r: ImpulseResult, path: Path, label: str) -> Path:
     return plots._save(fig, path)
 
 
-def write(r: ImpulseResult, out: Path, controller: str) -> None:
+def write(r: ImpulseResult, out: Path, controller: str, scenario: dict | None = None) -> None:
+    """scenario: the scenario file's description (recorded)."""
     out = Path(out)
-    atomic.write_json(out / "impulse.json", {"controller": controller, **r.as_dict()})
+    atomic.write_json(out / "impulse.json", {"controller": controller, "scenario": scenario, **r.as_dict()})
     plot(r, out / "impulse.png", controller)

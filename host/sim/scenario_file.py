@@ -110,7 +110,10 @@ READINGS: dict[str, tuple[str, dict]] = {
                 wheels=_source_values(0.01, 0.01, "1sigma", 0.1)),
     ),
 }
-DEFAULT_READING = "table6"
+# The commands' default (--scenario absent): the reading the calibration study chose by fitting the
+# Table 1 PID's rows of Tables 8-9 (BENCHMARKS.md, "Calibration of Table 6"); the simulators' own
+# default (host.sim.simulator.SimConfig) stays the literal `table6` reading.
+DEFAULT_READING = "norm-star_norm-gyro_mnm-wheels"
 
 # The calibration study's candidates (host.tune.calibrate, docs/scenario.md "Readings"): every
 # combination of one defensible reading per source. A "norm" reading takes Table 6's values as the

@@ -11,8 +11,9 @@ docs/scenario.md). The study keeps fitting and predicting apart:
 2. Predict, with no further adjustment: under the chosen reading the network (and the tuned PID
    when given) flies the same runs and the step response (Tables 10-11); the network's rows and the
    NN/PID ratio are reported against the published ones as measured, whatever they are.
-3. The ratio against noise: every random error of the chosen reading scaled by 0 … 1.5, the NN / PID
-   J̄ over the targets at each scale, with the paper's 0.66 marked (fig_ratio_vs_noise.png).
+3. The ratio against noise: every random error of the `table6` reading (the literal one) scaled by
+   0 … 1.5, the NN / PID J̄ over the targets at each scale, with the paper's 0.66 marked
+   (fig_ratio_vs_noise.png): how much noise the paper's ratio would need.
 
 Every run is batched (host.sim.batched, controllers side by side on common noise).
 """
@@ -102,9 +103,12 @@ def predict(plan: CalibrationPlan, errors, specs: list[ControllerSpec], progress
     return {"staring": staring, "step": {label: s["mean"] for label, s in step.items()}}
 
 
+SWEEP_READING = "table6"
+
+
 def noise_sweep(plan: CalibrationPlan, errors, specs: list[ControllerSpec], progress: bool) -> dict:
-    """Step 3: J̄ over the targets of every spec with every random error scaled."""
-    out = {"scales": list(plan.scales), "J": {s.label: [] for s in specs}}
+    """Step 3: J̄ over the targets of every spec with every random error of `errors` scaled."""
+    out = {"reading": errors.reading, "scales": list(plan.scales), "J": {s.label: [] for s in specs}}
     for scale in plan.scales:
         ev = plan.eval_plan(errors.scaled(scale))
         res = fly_bank(ev, specs, [(lon, lat) for _, lon, lat, _ in plan.targets], [s for *_, s in plan.targets],
@@ -149,7 +153,7 @@ def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: Controller
     prediction = predict(plan, scenario.errors, specs, progress)
     times["predict_s"] = round(time.perf_counter() - t0, 2)
     t0 = time.perf_counter()
-    sweep = noise_sweep(plan, scenario.errors, specs, progress)
+    sweep = noise_sweep(plan, scenario_file.from_reading(SWEEP_READING).errors, specs, progress)
     times["sweep_s"] = round(time.perf_counter() - t0, 2)
     nn = prediction["staring"][network.label]["all"]["J"]
     ratios = {label: nn / row["all"]["J"] for label, row in prediction["staring"].items() if label != network.label}
@@ -175,7 +179,7 @@ def plot_ratio_vs_noise(doc: dict, path) -> None:
             ax.plot(sweep["scales"], nn / np.array(sweep["J"][labels[key]]), marker="o", label=f"NN / {labels[key]}")
     ax.axhline(doc["paper_nn_to_pid_ratio"], color="k", ls="--", lw=0.8, label="paper 001 (Table 9): 0.66")
     ax.axvline(1.0, color="0.6", lw=0.8)
-    ax.set_xlabel(f"scale on every random error of the reading {doc['chosen']}")
+    ax.set_xlabel(f"scale on every random error of the reading {sweep.get('reading', '?')}")
     ax.set_ylabel("J̄ ratio over the targets")
     ax.set_title("Network / PID against the noise level", fontsize=10)
     ax.grid(True, lw=0.3)

@@ -250,7 +250,8 @@ def result_document(plan: TuningPlan, result: TuningResult, timing: dict) -> dic
                       "table1_objective": None if i1 is None else float(result.objective[i1, a])}
     return {"format": "staregen-pid-tuning-result/1", "plan_hash": plan.plan_hash(), "grid": plan.grid.name,
             "triples": len(plan.grid), "targets": len(plan.targets), "seeds": list(plan.seeds),
-            "duration": plan.duration, "best": axes, "check": result.check, "timing": timing}
+            "duration": plan.duration, "scenario": plan.scenario or {"reading": plan.errors.reading},
+            "best": axes, "check": result.check, "timing": timing}
 
 
 def tune(directory, plan: TuningPlan, base_config: pc.PackageConfig, scheduler: str | None = None,

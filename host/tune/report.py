@@ -234,7 +234,7 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
                       _g(b["table1_objective"]) if b["table1_on_grid"] else "not on grid")
                      for axis, b in tuning["best"].items())
         blocks += [Block("h2", f"PID tuning (§7.2, Table 7 grid '{tuning['grid']}': {tuning['triples']} triples, "
-                               f"{tuning['targets']} targets, {tuning['duration']:g} s)"),
+                               f"{tuning['targets']} targets, {tuning['duration']:g} s)" + _scenario_tag(tuning)),
                    Block("table", header=("axis", "Kp", "Ki", "Kd", "objective (axis share of eq. 8)",
                                           "Table 1 on the grid"), rows=rows),
                    Block("p", f"Check run (different triple per axis, coupling included): J̄ Table 1 "

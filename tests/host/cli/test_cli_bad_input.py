@@ -170,7 +170,7 @@ CASES = [
 
 def _bad_scenarios(folder) -> dict[str, str]:
     """Scenario files with one defect each (edited from a valid, sealed one: the value check comes first)."""
-    good = scenario_file.to_toml(scenario_file.default_scenario())
+    good = scenario_file.to_toml(scenario_file.from_reading("table6"))
     edits = {"scen_nan": ("random_arcsec = [3.0, 3.0, 3.0]", "random_arcsec = [nan, 3.0, 3.0]"),
              "scen_negative": ("random_deg_per_h = [0.15, 0.15, 0.15]", "random_deg_per_h = [-0.15, 0.15, 0.15]"),
              "scen_unknown": ("[wheels]", "[wheels]\nspin = 1"),

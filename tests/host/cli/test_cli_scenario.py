@@ -6,6 +6,7 @@ import pytest
 
 from host.cli import main
 from host.core.constants import ARCSEC
+from host.sim import scenario_file as sf
 from tests.host.sim.test_scenario_file import BAD_FILES, VALID_BODY, write_bad
 
 
@@ -24,6 +25,15 @@ def assert_refused(code: int, out: str, err: str, *words: str) -> None:
         assert word in err, err
 
 
+def test_init_writes_the_default_reading(tmp_path, capsys):
+    """Without --reading: the commands' default, the calibration study's choice (not table6)."""
+    path = tmp_path / "default.toml"
+    code, out, err = run(capsys, "scenario", "init", "--out", str(path))
+    assert code == 0 and err == ""
+    scenario = sf.load(path)
+    assert scenario.reading == sf.DEFAULT_READING != "table6" and scenario.sha256 == sf.default_scenario().sha256
+
+
 def test_list_names_table6(capsys):
     code, out, err = run(capsys, "scenario", "list")
     assert code == 0 and err == ""
@@ -32,7 +42,7 @@ def test_list_names_table6(capsys):
 
 def test_init_check_seal(tmp_path, capsys):
     path = tmp_path / "scenario.toml"
-    code, out, err = run(capsys, "scenario", "init", "--out", str(path))
+    code, out, err = run(capsys, "scenario", "init", "--reading", "table6", "--out", str(path))
     assert code == 0 and err == "" and path.is_file()
     code, out, err = run(capsys, "scenario", "check", str(path))
     assert code == 0 and err == ""

@@ -66,7 +66,7 @@ def test_failure_during_the_run_leaves_no_partial_output(tmp_path, capsys, monke
     out.mkdir()
     (out / "metrics.json").write_text('{"J": 1}')   # a previous run's output
 
-    def broken_write(result, folder):
+    def broken_write(result, folder, scenario=None):
         (folder / "metrics.json").write_text("{half")
         raise OSError(28, "No space left on device")
 

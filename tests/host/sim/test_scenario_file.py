@@ -153,7 +153,7 @@ def assert_one_line(message: str, path: Path, key: str) -> None:
 
 
 def test_table6_resolves_exactly_to_table6_errors(valid_file):
-    for scenario in (sf.default_scenario(), sf.from_reading("table6"), sf.load(valid_file)):
+    for scenario in (sf.from_reading("table6"), sf.load(valid_file)):
         e = scenario.errors
         assert e == TABLE6_ERRORS
         # bit for bit, from the schema: bias = value·unit, σ = value/k·unit

@@ -69,11 +69,13 @@ def test_candidate_rows_are_the_pid_under_that_reading(networks):
     direct = simulate_pid_batch([(t.lon, t.lat) for t in ts], GainSets.of(TABLE1_GAINS), (0,),
                                 SimConfig(duration=12.0, errors=errors))
     assert abs(doc["candidates"][0]["pid"]["all"]["J_A"] - direct.J_A.mean()) <= 1e-12 * direct.J_A.mean()
-    # scale 0: no random error at all, the constants kept
+    # the sweep scales the literal table6 reading; scale 0: no random error at all, the constants kept
+    table6 = scenario_file.from_reading("table6").errors
     quiet = simulate_pid_batch([(t.lon, t.lat) for t in ts], GainSets.of(TABLE1_GAINS), (0,),
-                               SimConfig(duration=12.0, errors=errors.scaled(0.0)))
+                               SimConfig(duration=12.0, errors=table6.scaled(0.0)))
     assert abs(doc["noise_sweep"]["J"]["PID (Table 1)"][0] - quiet.J().mean()) <= 1e-12 * quiet.J().mean()
-    assert np.all(np.asarray(errors.scaled(0.0).star.sigma) == 0) and errors.scaled(0.0).star.bias == errors.star.bias
+    assert doc["noise_sweep"]["reading"] == "table6"
+    assert np.all(np.asarray(table6.scaled(0.0).star.sigma) == 0) and table6.scaled(0.0).star.bias == table6.star.bias
 
 
 def test_cli_writes_the_chosen_reading_as_a_sealed_scenario(networks, tmp_path, capsys):
