@@ -53,6 +53,8 @@ class PipelineContext:
     artifact: object = None                       # the network artifact (codegen.artifact.Artifact)
     unit: object = None                           # the network unit generated from it
     report: list[str] = field(default_factory=list)
+    # the reading of Table 6 every stage flies (the commands' default: the calibration study's)
+    scenario: scenario_file.Scenario = field(default_factory=scenario_file.default_scenario)
 
 
 def stage_scenario(ctx: PipelineContext) -> None:
@@ -67,16 +69,19 @@ def stage_scenario(ctx: PipelineContext) -> None:
                          "argp_deg": e.argp / DEG, "nu_deg": e.nu / DEG},
                "central_target_elevation_deg": {"start": float(el[0]), "max": float(np.max(el)),
                                                 "end": float(el[-1])}}
+    summary["errors"] = ctx.scenario.describe()
     ctx.results["scenario"] = summary
-    ctx.report.append(f"scenario: epoch {summary['epoch_utc']} UTC, central target elevation "
+    ctx.report.append(f"scenario: Table 6 errors read as {ctx.scenario.reading} (sha256 {ctx.scenario.sha256[:16]}…); "
+                      f"epoch {summary['epoch_utc']} UTC, central target elevation "
                       f"{el[0]:.1f}° -> max {np.max(el):.1f}° -> {el[-1]:.1f}° over {PRESET_DURATION_S:g} s")
 
 
 def stage_pid_central(ctx: PipelineContext) -> None:
     """The paper's PID (Table 1) staring at the central target; metrics printed and saved."""
-    result = run_campaign("pid", [central_target()], SimConfig(duration=PRESET_DURATION_S, seed=PRESET_SEED),
+    result = run_campaign("pid", [central_target()], SimConfig(duration=PRESET_DURATION_S, seed=PRESET_SEED,
+                                                             errors=ctx.scenario.errors),
                           DEFAULT_PLAN, progress=False)
-    write_campaign(result, ctx.out / "pid_central")
+    write_campaign(result, ctx.out / "pid_central", ctx.scenario.describe())
     a = result.average
     ctx.results["pid_central"] = {"J_A": a.J_A, "J_w": a.J_w, "J": a.J, "run_time_s": result.run_time_s}
     ctx.report.append(format_table(result))
@@ -183,7 +188,8 @@ def stage_tune(ctx: PipelineContext) -> None:
     from host.tune.pid_grid import grid
     from host.tune.pid_tuning import TuningPlan, tune
 
-    plan = TuningPlan(grid=grid("coarse"), targets=parse_targets(str(TUNE_TARGETS)), duration=TUNE_DURATION_S)
+    plan = TuningPlan(grid=grid("coarse"), targets=parse_targets(str(TUNE_TARGETS)), duration=TUNE_DURATION_S,
+                      errors=ctx.scenario.errors, scenario=ctx.scenario.describe())
     doc = tune(ctx.out / "tune", plan, default_package_config(), progress=False)
     best = {a: [doc["best"][a][k] for k in ("kp", "ki", "kd")] for a in doc["best"]}
     ctx.results["tune"] = {"folder": "tune", "grid": "coarse", "best_kp_ki_kd": best, "check": doc["check"]}
@@ -213,7 +219,7 @@ def stage_dp(ctx: PipelineContext) -> None:
 def stage_evaluate(ctx: PipelineContext) -> None:
     """NN (float64, SIL, PIL on the central target), Table 1 and tuned PID, PD+FF, the discrete-point
     law (float64, SIL): staring, step, frequency and impulse responses at paper scale on the batched
-    simulator, under the default scenario (the `table6` reading) (<out>/evaluate), then the report
+    simulator, under the pipeline's scenario (the commands' default reading) (<out>/evaluate), then the report
     (<out>/report)."""
     from host.cli.evaluate import summary
     from host.cli.tune import parse_targets
@@ -223,7 +229,7 @@ def stage_evaluate(ctx: PipelineContext) -> None:
 
     targets = parse_targets("all")
     c = central_target()
-    scenario = scenario_file.default_scenario()
+    scenario = ctx.scenario
     plan = EvalPlan(targets=targets, response_targets=targets, central=(c.name, c.lon, c.lat, 0),
                     duration=PRESET_DURATION_S, errors=scenario.errors)
     tuned = pc.load(ctx.out / "tune" / "controller.toml").controller
