@@ -29,22 +29,11 @@ from tools.inloop import InTheLoop
 from tools.runners import runner
 
 
-def pack_input(m: Measurement) -> np.ndarray:
-    """One input record from a Measurement (float32 rounding happens here, as on board)."""
+def pack_input(m: Measurement | BatchMeasurement) -> np.ndarray:
+    """Input records from a Measurement (one record) or a BatchMeasurement (one per row, one clock and
+    one GPS fix for all); the float32 rounding happens here, as on board."""
     jd, sec = normalise_time(int(m.jd_days), float(m.sec_of_day))
-    rec = np.zeros(1, dtype=INPUT_DTYPE)
-    rec["A_bo"], rec["omega_b"] = m.A_bo, m.omega_b
-    rec["R_s"], rec["V_s"] = m.R_s, m.V_s
-    rec["lon"], rec["lat"] = to_bam(m.lon), to_bam(m.lat)
-    rec["utc_day"] = int(jd) - cs.J2000_JDN
-    rec["utc_ms"] = int(round(float(sec) * 1000.0))
-    return rec
-
-
-def pack_rows(m: BatchMeasurement) -> np.ndarray:
-    """pack_input for every row of a BatchMeasurement (one clock and one GPS fix for all rows)."""
-    jd, sec = normalise_time(int(m.jd_days), float(m.sec_of_day))
-    rec = np.zeros(m.rows, dtype=INPUT_DTYPE)
+    rec = np.zeros(m.rows if isinstance(m, BatchMeasurement) else 1, dtype=INPUT_DTYPE)
     rec["A_bo"], rec["omega_b"] = m.A_bo, m.omega_b
     rec["R_s"], rec["V_s"] = m.R_s, m.V_s
     rec["lon"], rec["lat"] = to_bam(m.lon), to_bam(m.lat)
@@ -91,7 +80,7 @@ class GeneratedBatch:
         self.state = self.unit.init_state(layout.rows)
 
     def step(self, m: BatchMeasurement) -> BatchOutput:
-        out, self.state = self.run.records(Batch(self.state, pack_rows(m)))
+        out, self.state = self.run.records(Batch(self.state, pack_input(m)))
         return BatchOutput(torque=out["torque"].astype(float), saturated=(out["status"] & cs.STATUS_SATURATED) != 0)
 
 
