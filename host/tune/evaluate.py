@@ -34,6 +34,7 @@ from multiprocessing import get_context
 from typing import Callable
 
 import numpy as np
+from tqdm import tqdm
 
 from host.control.batch import ControllerBank
 from host.control.controllers import build_batch_controller, build_controller, has_batch
@@ -183,8 +184,6 @@ def _job_history(make, lon, lat, cfg: SimConfig, stream: int) -> np.ndarray:
 
 
 def _run(fn, jobs: list[tuple], workers: int | None, progress: bool, desc: str) -> list:
-    from tqdm import tqdm
-
     workers = max(1, min(workers or os.cpu_count() or 1, len(jobs)))
     results: list = [None] * len(jobs)
     with tqdm(total=len(jobs), desc=desc, unit="run", disable=not progress, mininterval=0.5) as bar:
@@ -205,8 +204,6 @@ def _run(fn, jobs: list[tuple], workers: int | None, progress: bool, desc: str) 
 
 def _bar_callback(total: int, progress: bool, desc: str):
     """(callback(k), close()) of a tqdm bar over the control steps of one batched run."""
-    from tqdm import tqdm
-
     bar = tqdm(total=total, desc=desc, unit="step", disable=not progress, mininterval=0.5)
     return (lambda k: bar.update()), bar.close
 
@@ -229,19 +226,15 @@ def _split(plan: EvalPlan, specs: list[ControllerSpec]) -> tuple[list, list]:
 
 # ----------------------------------------------------------------------------- staring (Tables 8-9)
 
-def staring(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True,
-            known: dict | None = None) -> dict:
-    """Rows of the staring table; `known` rows (label -> row) are taken as they are, not flown again."""
+def scalar_staring(plan: EvalPlan, specs: list[ControllerSpec], workers=None, progress=True,
+                   known: dict | None = None) -> dict:
+    """Rows of the staring table on the scalar simulator (the PIL run on the central target only);
+    `known` rows (label -> row) are taken as they are, not flown again."""
     cfg = plan.config(plan.duration)
-    known = known or {}
-    batched, scalar = _split(plan, [s for s in specs if s.label not in known])
-    rows = dict(known)
-    if batched:
-        res = fly_bank(plan, batched, [(lon, lat) for _, lon, lat, _ in plan.targets],
-                        [s for *_, s in plan.targets], cfg, progress, f"staring ({len(plan.targets)} targets)")
-        for g, spec in enumerate(batched):
-            rows[spec.label] = _row(res.J_A[:, g, 0], res.J_w[:, g, 0], plan)
-    for spec in scalar:
+    rows = dict(known or {})
+    for spec in specs:
+        if spec.label in rows:
+            continue
         targets = [plan.central] if spec.name == "nn-arm" else list(plan.targets)
         make = spec.factory(cfg.spacecraft.torque_limit, cfg.control_period)
         out = _run(_job_metrics, [(make, lon, lat, cfg, s) for _, lon, lat, s in targets], workers, progress,
@@ -365,9 +358,9 @@ def staring_tables(plan: EvalPlan, specs: list[ControllerSpec], workers=None, pr
             rows_c[spec.label] = _row(res.J_A[:1, g, 0], res.J_w[:1, g, 0], plan)
             rows_t[spec.label] = _row(res.J_A[1:, g, 0], res.J_w[1:, g, 0], plan)
     if scalar:
-        rows_c.update(staring(central_plan, scalar, workers, progress))
-        rows_t.update(staring(plan, scalar, workers, progress,
-                              known={s.label: rows_c[s.label] for s in scalar if s.name == "nn-arm"}))
+        rows_c.update(scalar_staring(central_plan, scalar, workers, progress))
+        rows_t.update(scalar_staring(plan, scalar, workers, progress,
+                                     known={s.label: rows_c[s.label] for s in scalar if s.name == "nn-arm"}))
     return {"staring": {s.label: rows_t[s.label] for s in specs},
             "staring_central": {s.label: rows_c[s.label] for s in specs}}
 
