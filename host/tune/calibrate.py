@@ -11,6 +11,9 @@ docs/scenario.md). The study keeps fitting and predicting apart:
 2. Predict, with no further adjustment: under the chosen reading the network (and the tuned PID
    when given) flies the same runs and the step response (Tables 10-11); the network's rows and the
    NN/PID ratio are reported against the published ones as measured, whatever they are.
+   Beside the readings, a one-parameter fit that is not a reading of the words: every random error
+   of `table6` times a scale s (its constants kept), s chosen by the same residual on the PID only
+   (bounded scalar minimisation), and the network predicted at that s as in step 2.
 3. The ratio against noise: every random error of the `table6` reading (the literal one) scaled by
    0 … 1.5, the NN / PID J̄ over the targets at each scale, with the paper's 0.66 marked
    (fig_ratio_vs_noise.png): how much noise the paper's ratio would need.
@@ -23,6 +26,7 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from codegen import atomic
 from host.errors import HostError
@@ -47,6 +51,7 @@ class CalibrationPlan:
     response_targets: int = 100
     scales: tuple[float, ...] = DEFAULT_SCALES
     seed: int = 0
+    scale_tolerance: float = 0.005      # of the one-parameter noise-scale fit
 
     def __post_init__(self):
         if not self.readings:
@@ -94,6 +99,37 @@ def fit_pid(plan: CalibrationPlan, table1: ControllerSpec, progress: bool) -> li
                      "pid": pid, "residual": residual(pid),
                      "ratios": {f"{where} {metric}": pid[where][metric] / paper for where, metric, paper in PID_FIGURES}})
     return rows
+
+
+SCALE_BOUNDS = (0.05, 1.5)
+
+
+def scaled_scenario(reading: str, scale: float) -> scenario_file.Scenario:
+    """The reading with every random value times `scale`, as a scenario of its own (a file can hold it)."""
+    base = scenario_file.from_reading(reading).values
+    values = {**base, "reading": f"{reading}-random-x{round(scale * 1000):04d}"}
+    for keys in scenario_file.SOURCES:
+        table = dict(base[keys.table])
+        table[keys.random] = [float(v) * scale for v in table[keys.random]]
+        values[keys.table] = table
+    return scenario_file.from_values(values)
+
+
+def fit_noise_scale(plan: CalibrationPlan, table1: ControllerSpec, progress: bool,
+                    reading: str = "table6") -> dict:
+    """The scale on every random error of `reading` that minimises the PID's residual (PID only)."""
+    tried = {}
+
+    def residual_at(scale: float) -> float:
+        pid = staring_pair(plan, scaled_scenario(reading, scale).errors, [table1], progress,
+                           f"scale x{scale:.3f}")[table1.label]
+        tried[float(scale)] = (residual(pid), pid)
+        return tried[float(scale)][0]
+    best = minimize_scalar(residual_at, bounds=SCALE_BOUNDS, method="bounded", options={"xatol": plan.scale_tolerance})
+    scale = float(best.x)
+    res, pid = tried[scale]
+    return {"reading": reading, "scale": scale, "residual": res, "pid": pid,
+            "tried": [{"scale": k, "residual": v[0]} for k, v in sorted(tried.items())]}
 
 
 def predict(plan: CalibrationPlan, errors, specs: list[ControllerSpec], progress: bool) -> dict:
@@ -147,6 +183,9 @@ def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: Controller
     candidates = fit_pid(plan, table1, progress)
     times["fit_s"] = round(time.perf_counter() - t0, 2)
     chosen = min(candidates, key=lambda c: c["residual"])
+    t0 = time.perf_counter()
+    scale_fit = fit_noise_scale(plan, table1, progress)
+    times["scale_fit_s"] = round(time.perf_counter() - t0, 2)
     scenario = scenario_file.from_reading(chosen["reading"])
     specs = [table1] + ([tuned] if tuned else []) + [network]
     t0 = time.perf_counter()
@@ -157,6 +196,12 @@ def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: Controller
     times["sweep_s"] = round(time.perf_counter() - t0, 2)
     nn = prediction["staring"][network.label]["all"]["J"]
     ratios = {label: nn / row["all"]["J"] for label, row in prediction["staring"].items() if label != network.label}
+    scaled = scaled_scenario(scale_fit["reading"], scale_fit["scale"])
+    scale_fit["scenario"] = scaled.describe()
+    scale_fit["prediction"] = staring_pair(plan, scaled.errors, specs, progress, "predict at the fitted scale")
+    nn_s = scale_fit["prediction"][network.label]["all"]["J"]
+    scale_fit["nn_to_pid_ratio"] = {label: nn_s / row["all"]["J"] for label, row in scale_fit["prediction"].items()
+                                    if label != network.label}
     return {"plan": {"targets": len(plan.targets), "duration": plan.duration, "seed": plan.seed,
                      "response_targets": plan.response_targets, "step_duration": plan.step_duration,
                      "readings": list(plan.readings)},
@@ -164,7 +209,7 @@ def calibrate(plan: CalibrationPlan, table1: ControllerSpec, network: Controller
             "candidates": sorted(candidates, key=lambda c: c["residual"]), "chosen": chosen["reading"],
             "chosen_scenario": scenario.describe(), "prediction": prediction,
             "nn_to_pid_ratio": ratios, "paper_nn_to_pid_ratio": paper001.NN_TO_PID_RATIO,
-            "noise_sweep": sweep, "step_model": step_model(specs, network, network_pdff), "timing": times}
+            "noise_sweep": sweep, "scale_fit": scale_fit, "step_model": step_model(specs, network, network_pdff), "timing": times}
 
 
 # ----------------------------------------------------------------------------- files
@@ -200,6 +245,15 @@ def summary_lines(doc: dict) -> list[str]:
         lines.append(f"  {label:16s} {doc['plan']['targets']} targets J_A {a['J_A']:.3e}  J_w {a['J_w']:.3e}  J {a['J']:.3e}")
     for label, r in doc["nn_to_pid_ratio"].items():
         lines.append(f"  NN / {label}: {r:.3f} (paper {doc['paper_nn_to_pid_ratio']:.3f})")
+    fit = doc.get("scale_fit")
+    if fit:
+        lines.append(f"one-parameter fit (not a reading): every random error of {fit['reading']} x {fit['scale']:.3f}, "
+                     f"PID residual {fit['residual']:.3f}")
+        for label, row in fit["prediction"].items():
+            a = row["all"]
+            lines.append(f"  {label:16s} J_A {a['J_A']:.3e}  J_w {a['J_w']:.3e}  J {a['J']:.3e}")
+        for label, r in fit["nn_to_pid_ratio"].items():
+            lines.append(f"  NN / {label}: {r:.3f} (paper {doc['paper_nn_to_pid_ratio']:.3f})")
     return lines
 
 
@@ -209,4 +263,7 @@ def write(doc: dict, out) -> None:
     atomic.write_json(out / "calibration.json", doc)
     plot_ratio_vs_noise(doc, out / "fig_ratio_vs_noise.png")
     scenario_file.write(scenario_file.from_reading(doc["chosen"]), out / "scenario.toml")
+    if doc.get("scale_fit"):
+        scenario_file.write(scenario_file.from_values(doc["scale_fit"]["scenario"]["values"]),
+                            out / "scenario_scale_fit.toml")
     atomic.write_text(out / "calibration.txt", "\n".join(summary_lines(doc)) + "\n")

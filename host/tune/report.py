@@ -154,6 +154,23 @@ def _fidelity_staring(evaluation: dict, cal: dict) -> list[Block]:
     return [Block("table", header=header, rows=tuple(rows))]
 
 
+def _scale_fit_blocks(fit: dict | None, labels: dict, paper_ratio: float) -> list[Block]:
+    """The one-parameter fit (a scale on every random error, PID only) and its prediction."""
+    if not fit:
+        return []
+    rows = []
+    for title, where, paper in (("Table 8", "central", PAPER_TABLE8), ("Table 9", "all", PAPER_TABLE9)):
+        for key, label in (("PID", labels["table1"]), ("NN", labels["network"])):
+            c, p = fit["prediction"][label][where], paper[key]
+            rows.append((title, label, _g(p[0]), _g(p[1]), _g(p[2]), _g(c["J_A"]), _g(c["J_w"]), _g(c["J"])))
+    ratios = "; ".join(f"NN / {label} {r:.2f}" for label, r in fit["nn_to_pid_ratio"].items())
+    return [Block("p", f"Not a reading but a one-parameter fit, on the PID only: every random error of "
+                       f"{fit['reading']} times {fit['scale']:.3f} (constants kept) gives the PID residual "
+                       f"{_g(fit['residual'])}. Predicted at that scale: {ratios} (paper {paper_ratio:.2f})."),
+            Block("table", header=("table", "controller", "paper J_A", "paper J_ω", "paper J̄", "fitted-scale J_A",
+                                   "fitted-scale J_ω", "fitted-scale J̄"), rows=tuple(rows))]
+
+
 def _step_model_blocks(model: dict | None, measured: dict) -> list[Block]:
     """What sets the step response: the per-axis PD model of each law against the measured settling."""
     if not model or not model.get("laws"):
@@ -204,6 +221,7 @@ def fidelity_blocks(evaluation: dict, cal: dict, figure: Path | None) -> list[Bl
         out += [Block("p", "Step response under the chosen reading beside Tables 10-11 (mean over the response targets):"),
                 Block("table", header=("controller", "index", "x", "y", "z", "paper x", "paper y", "paper z"),
                       rows=tuple(rows))]
+    out += _scale_fit_blocks(cal.get("scale_fit"), labels, cal["paper_nn_to_pid_ratio"])
     out += _step_model_blocks(cal.get("step_model"), step)
     if figure is not None:
         out.append(Block("img", text="NN / PID J̄ against a scale on every random error (paper's ratio marked)",

@@ -12,6 +12,7 @@ import pytest
 
 from codegen.artifact import random_artifact
 from host.cli import main
+from host.core.constants import ARCSEC
 from host.control.nn_controller import load_artifact
 from host.control.pid import GainSets, TABLE1_GAINS
 from host.sim import scenario_file
@@ -28,7 +29,7 @@ def _plan(**kw) -> cal.CalibrationPlan:
     c = central_target()
     targets = tuple((t.name, t.lon, t.lat, i) for i, t in enumerate(staring_targets()[:2]))
     args = dict(targets=targets, central=(c.name, c.lon, c.lat, 0), readings=READINGS, duration=12.0,
-                step_duration=45.0, response_targets=1, scales=(0.0, 1.0))
+                step_duration=45.0, response_targets=1, scales=(0.0, 1.0), scale_tolerance=0.2)
     args.update(kw)
     return cal.CalibrationPlan(**args)
 
@@ -55,6 +56,9 @@ def test_the_fit_does_not_see_the_network(networks):
     docs = [cal.calibrate(_plan(), table1_spec(), ControllerSpec("NN (float64)", "nn", (("artifact", n),)),
                           progress=False) for n in networks]
     assert docs[0]["candidates"] == docs[1]["candidates"] and docs[0]["chosen"] == docs[1]["chosen"]
+    fits = [{k: v for k, v in d["scale_fit"].items() if k not in ("prediction", "nn_to_pid_ratio")} for d in docs]
+    assert fits[0] == fits[1]                     # the noise-scale fit does not see the network either
+    assert docs[0]["scale_fit"]["residual"] == min(t["residual"] for t in docs[0]["scale_fit"]["tried"])
     assert docs[0]["prediction"]["staring"]["NN (float64)"] != docs[1]["prediction"]["staring"]["NN (float64)"]
     residuals = {c["reading"]: c["residual"] for c in docs[0]["candidates"]}
     assert set(residuals) == set(READINGS)
@@ -88,3 +92,12 @@ def test_cli_writes_the_chosen_reading_as_a_sealed_scenario(networks, tmp_path, 
     assert chosen.reading == doc["chosen"] and chosen.sha256 == doc["chosen_scenario"]["sha256"]
     assert (out / "fig_ratio_vs_noise.png").stat().st_size > 1000
     assert doc["paper_nn_to_pid_ratio"] == pytest.approx(4.01e-4 / 6.09e-4)
+
+
+def test_a_scaled_scenario_scales_the_random_errors_only():
+    s = cal.scaled_scenario("table6", 0.3)
+    base = scenario_file.from_reading("table6").errors
+    assert s.reading == "table6-random-x0300"
+    assert abs(s.errors.star.sigma[0] - 0.3 * ARCSEC) < 1e-20 and abs(s.errors.wheels.sigma[2] - 0.003) < 1e-18
+    assert s.errors.star.bias == base.star.bias and s.errors.wheels.bias == base.wheels.bias
+    assert scenario_file.from_values(s.describe()["values"]).sha256 == s.sha256     # a file can hold it
