@@ -224,6 +224,9 @@ def plot_ratio_vs_noise(doc: dict, path) -> None:
             ax.plot(sweep["scales"], nn / np.array(sweep["J"][labels[key]]), marker="o", label=f"NN / {labels[key]}")
     ax.axhline(doc["paper_nn_to_pid_ratio"], color="k", ls="--", lw=0.8, label="paper 001 (Table 9): 0.66")
     ax.axvline(1.0, color="0.6", lw=0.8)
+    fit = doc.get("scale_fit")
+    if fit and fit.get("reading") == sweep.get("reading"):
+        ax.axvline(fit["scale"], color="tab:red", ls=":", lw=1.0, label=f"noise scale fitted on the PID: {fit['scale']:.2f}")
     ax.set_xlabel(f"scale on every random error of the reading {sweep.get('reading', '?')}")
     ax.set_ylabel("J̄ ratio over the targets")
     ax.set_title("Network / PID against the noise level", fontsize=10)
