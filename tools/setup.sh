@@ -16,12 +16,14 @@ fi
 
 # cmake builds the flight package with its own CMakeLists (staregen generate, package check, tests);
 # cppcheck with its MISRA addon checks the generated C (staregen misra); llvm gives llvm-mca, the
-# lower bound the cycle model's block costs are checked against (tools/m4/mca.py).
+# lower bound the cycle model's block costs are checked against (tools/m4/mca.py); clang builds the
+# package as a firmware team on clang/armclang would; qemu-system-arm runs its image as a second emulator.
 if ! command -v cmake >/dev/null 2>&1 || ! command -v cppcheck >/dev/null 2>&1 \
-   || [ -z "$(compgen -c llvm-mca)" ]; then
-  echo "setup: installing cmake, cppcheck and llvm (apt)"
+   || [ -z "$(compgen -c llvm-mca)" ] || ! command -v clang >/dev/null 2>&1 \
+   || ! command -v qemu-system-arm >/dev/null 2>&1; then
+  echo "setup: installing cmake, cppcheck, llvm, clang and qemu-system-arm (apt)"
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck llvm >/dev/null
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck llvm clang qemu-system-arm >/dev/null
 fi
 
 stamp=.setup-stamp
