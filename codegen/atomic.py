@@ -2,16 +2,26 @@
 
 Every layer writes its artifacts through these helpers (write to a temporary sibling, fsync,
 then os.replace, which is atomic on POSIX within one filesystem).
+
+A whole output folder (`directory`) is written under a lock beside it (`.<name>.lock`: a second
+run into the same folder fails at once); its temporaries are named `.<name>.<pid>.XXXXXXXX.tmp`
+(and `.old`) so that a later run removes those of a killed run, and nothing else.
 """
 from __future__ import annotations
 
+import fcntl
 import json
 import os
+import re
 import shutil
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
+
+from codegen.errors import CodegenError
+
+LOCK_ATTEMPTS = 5   # a releasing run removes its lock file; reopen when it vanished under us
 
 
 def _umask_mode(base: int = 0o666) -> int:
@@ -85,23 +95,129 @@ def writing(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
         raise
 
 
+class FolderInUse(CodegenError):
+    """Another run holds the output folder's lock."""
+
+
+def lock_path(path: Path) -> Path:
+    return path.with_name(f".{path.name}.lock")
+
+
+def _open_lock(path: Path) -> int | None:
+    """The locked descriptor of `path`'s lock file, or None when the file vanished between open
+    and flock (retry)."""
+    lock = lock_path(path)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        os.close(fd)
+        raise FolderInUse(f"output folder {path} is in use by another run "
+                          f"(lock {lock.name} held); wait for it or choose another folder") from None
+    try:
+        same = os.stat(lock, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
+    except FileNotFoundError:
+        same = False
+    if not same:
+        os.close(fd)
+        return None
+    return fd
+
+
 @contextmanager
-def directory(path: str | os.PathLike) -> Iterator[Path]:
-    """Build a whole directory in a temporary sibling; it replaces `path` only on success."""
+def locked(path: str | os.PathLike) -> Iterator[None]:
+    """Hold the lock of output folder `path` (fcntl.flock on `.<name>.lock` beside it, which the
+    holder removes on release); FolderInUse when another run holds it."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent))
+    for _ in range(LOCK_ATTEMPTS):
+        fd = _open_lock(path)
+        if fd is not None:
+            break
+    else:
+        raise FolderInUse(f"cannot lock output folder {path}: {lock_path(path).name} keeps being replaced")
+    try:
+        yield
+    finally:
+        lock_path(path).unlink(missing_ok=True)   # while still held: a waiter that opened it sees another inode
+        os.close(fd)
+
+
+def _temp_prefix(path: Path) -> str:
+    return f".{path.name}.{os.getpid()}."
+
+
+def _stale_pattern(path: Path) -> re.Pattern:
+    """Names of this folder's temporaries (mkdtemp adds 8 characters of [a-z0-9_])."""
+    return re.compile(re.escape(f".{path.name}.") + r"(\d+)\.[a-z0-9_]{8}\.(?:tmp|old)")
+
+
+def _alive(pid: int) -> bool:
+    if pid <= 0 or pid == os.getpid():
+        return True   # never ours to judge: 0 would signal our own process group
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def remove_stale(path: Path) -> list[Path]:
+    """Remove the temporaries of `path` that a dead run left (call with the folder's lock held);
+    returns what was removed."""
+    pattern, removed = _stale_pattern(path), []
+    for entry in path.parent.iterdir():
+        match = pattern.fullmatch(entry.name)
+        if match and entry.is_dir() and not entry.is_symlink() and not _alive(int(match.group(1))):
+            shutil.rmtree(entry, ignore_errors=True)
+            removed.append(entry)
+    return removed
+
+
+@contextmanager
+def scratch(path: str | os.PathLike) -> Iterator[Path]:
+    """A working folder beside output folder `path`, named as its temporaries are (a killed run's
+    is removed by the next run); removed on exit."""
+    path = Path(path)
+    tmp = Path(tempfile.mkdtemp(prefix=_temp_prefix(path), suffix=".tmp", dir=path.parent))
     try:
         yield tmp
-        os.chmod(tmp, _umask_mode(0o777))
-        if path.exists():
-            old = path.with_name(f".{path.name}.old")
-            shutil.rmtree(old, ignore_errors=True)
-            os.replace(path, old)
-            os.replace(tmp, path)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, path)
-    except BaseException:
+    finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _move_in(tmp: Path, path: Path) -> None:
+    """Replace folder `path` by `tmp`; the old folder goes to a fresh temporary of this run, and
+    comes back if the second rename fails."""
+    if not path.exists() and not path.is_symlink():
+        os.replace(tmp, path)
+        return
+    old = Path(tempfile.mkdtemp(prefix=_temp_prefix(path), suffix=".old", dir=path.parent))
+    try:
+        os.replace(path, old)   # onto the empty folder mkdtemp made: allowed for folders
+    except BaseException:
+        old.rmdir()
         raise
+    try:
+        os.replace(tmp, path)
+    except BaseException:
+        os.replace(old, path)
+        raise
+    shutil.rmtree(old, ignore_errors=True)
+
+
+@contextmanager
+def directory(path: str | os.PathLike) -> Iterator[Path]:
+    """Build a whole directory in a temporary sibling; it replaces `path` only on success. The
+    folder is locked meanwhile (FolderInUse for a second run) and a dead run's temporaries go."""
+    path = Path(path)
+    if path.name in ("", ".", ".."):
+        raise CodegenError(f"output folder {path}: has no name (give a folder, not '.' or '/')")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with locked(path):
+        remove_stale(path)
+        with scratch(path) as tmp:
+            yield tmp
+            os.chmod(tmp, _umask_mode(0o777))
+            _move_in(tmp, path)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import tempfile
 import time
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -145,11 +146,13 @@ def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=prin
     }
 
 
-def run_package(folder: Path, name: str, targets=TARGETS, c_flags=()) -> dict:
+def run_package(folder: Path, name: str, targets=TARGETS, c_flags=(), work: Path | None = None) -> dict:
     """Build the package with its own CMakeLists for each target and run `<name>_selftest()`
-    (x86-64 natively, the STM32F417 image in the emulator, where the reference step is profiled)."""
+    (x86-64 natively, the STM32F417 image in the emulator, where the reference step is profiled).
+    The builds go into `work` (generate: a temporary beside the output that a later run removes if
+    this one is killed), else into a system temporary folder."""
     out = {}
-    with tempfile.TemporaryDirectory(prefix="staregen-pkg-") as tmp:
+    with nullcontext(work) if work is not None else tempfile.TemporaryDirectory(prefix="staregen-pkg-") as tmp:
         for target in targets:
             image = build_image(folder, name, target, Path(tmp) / target, c_flags=c_flags)
             if target == "x86":
@@ -187,16 +190,16 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
     vectors = [make_vectors(u, plan.selftest_vectors, plan.seed) for u in units.values()]
     files = source_files(name, units, vectors)
     seconds["render"] = round(time.perf_counter() - t0, 2)
-    log(f"package {name}: {len(files) + 2} files; measuring the evidence")
-    t1 = time.perf_counter()
-    evidence = build_evidence(units, vectors, plan, log)
-    seconds["evidence"] = round(time.perf_counter() - t1, 2)
     try:
-        with atomic.directory(out) as tmp:
+        with atomic.directory(out) as tmp, atomic.scratch(out) as work:   # locked from here: a second run fails
+            log(f"package {name}: {len(files) + 2} files; measuring the evidence")
+            t1 = time.perf_counter()
+            evidence = build_evidence(units, vectors, plan, log)
+            seconds["evidence"] = round(time.perf_counter() - t1, 2)
             for rel, text in files.items():
                 atomic.write_text(tmp / rel, text)
             t2 = time.perf_counter()
-            evidence["package_build"] = run_package(tmp, name)
+            evidence["package_build"] = run_package(tmp, name, work=work)
             seconds["package_build"] = round(time.perf_counter() - t2, 2)
             log("  package build: " + ", ".join(f"{t} self-test {r['selftest_mismatches']} mismatches"
                                                 for t, r in evidence["package_build"].items()))
