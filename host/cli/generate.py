@@ -17,8 +17,8 @@ from codegen.package.selftest import MAX_VECTORS
 from codegen.units.tanh.emit import params_sha256
 from codegen.units.tanh.params import load_params
 from host.cli.args import parse_int
-from host.cli.simulate import check_output_folder
 from host.errors import HostError
+from host.outputs import check_output_folder, package_owner
 from host.sim.scenarios import package_units
 from tools.package import EvidencePlan, build_package
 from tools.m4.profile import MODES
@@ -31,7 +31,8 @@ def register(subparsers) -> None:
     p.add_argument("--network", required=True, metavar="FILE", help="network artifact (e.g. out/pipeline/network.json)")
     p.add_argument("--tanh", default=None, metavar="FILE", help="tanh-law parameter file (when the configuration "
                    "includes the tanh unit)")
-    p.add_argument("--out", required=True, metavar="DIR", help="package folder (replaced if it holds a package)")
+    p.add_argument("--out", required=True, metavar="DIR", help="package folder (new or empty, or replaced if it holds "
+                   "exactly a staregen package)")
     add_evidence_arguments(p)
     p.set_defaults(func=run)
 
@@ -63,9 +64,10 @@ def file_sha256(path: Path) -> str:
 
 
 def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,
-             plan: EvidencePlan = EvidencePlan(), log=print):
-    """The package of a validated configuration and network (also the pipeline's last stage)."""
-    check_output_folder(out, marker="manifest.json")
+             plan: EvidencePlan = EvidencePlan(), log=print, input_paths=()):
+    """The package of a validated configuration and network (also the pipeline's last stage);
+    `input_paths`: the files read, which must not lie in the folder it replaces."""
+    check_output_folder(out, package_owner, input_paths)
     units = package_units(cfg, network, tanh)
     return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log)
 
@@ -94,6 +96,7 @@ def run(args: argparse.Namespace) -> int:
         tanh_path = Path(args.tanh)
         inputs["tanh"] = {"file": tanh_path.name, "sha256": file_sha256(tanh_path),
                           "values_sha256": params_sha256(tanh, cfg.controller.control_period)}
-    result = generate(cfg, network, Path(args.out), inputs, tanh, plan)
+    result = generate(cfg, network, Path(args.out), inputs, tanh, plan,
+                      input_paths=(args.config, args.network, args.tanh))
     print("\n".join(summary(result)))
     return 0

@@ -10,9 +10,10 @@ import argparse
 from pathlib import Path
 
 from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
-from host.cli.simulate import check_output_folder, controller_options
+from host.cli.simulate import controller_options
 from host.control.controllers import CONTROLLERS
 from host.errors import HostError
+from host.outputs import check_output_folder, json_marker_owner
 from codegen import atomic
 
 
@@ -40,7 +41,7 @@ def main(args: argparse.Namespace) -> int:
                         f"(the impulse ends then), got {duration:g}")
     options = controller_options(args)
     out = Path(args.out)
-    check_output_folder(out, marker="impulse.json")
+    check_output_folder(out, json_marker_owner("impulse.json"), [args.artifact, args.scenario])
     scenario = load_scenario(args.scenario)
     r = impulse.run(args.controller, options.get("artifact"), duration, parse_int(args.seed, "--seed"), scenario.errors)
     try:

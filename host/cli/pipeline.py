@@ -23,6 +23,7 @@ from host.sim.campaign import format_table, run_campaign, write_campaign
 from host.core.constants import DEG
 from host.plant.earth import elevation
 from host.errors import HostError
+from host.outputs import check_output_folder, json_marker_owner
 from host.sim import scenario_file
 from host.sim.metrics import DEFAULT_PLAN
 from host.plant.orbit import TABLE5_ELEMENTS, TABLE5_EPOCH_UTC
@@ -32,7 +33,6 @@ from codegen import atomic
 from codegen.cgen import write_sources
 from codegen.units.network.unit import NetworkUnit
 from host.cli.generate import file_sha256, generate, summary
-from host.cli.simulate import check_output_folder
 from host.control.nn_controller import CONFIG_SOURCES, default_package_config
 from codegen.package import config as pc
 from tools.package import EvidencePlan
@@ -275,7 +275,7 @@ def register(subparsers) -> None:
 
 def main(args: argparse.Namespace) -> int:
     out = Path(args.out)
-    check_output_folder(out, marker="report.json")
+    check_output_folder(out, json_marker_owner("report.json"))
     start = time.perf_counter()
     try:
         with atomic.directory(out) as tmp:

@@ -17,6 +17,7 @@ from host.control.baselines import load_baselines
 from host.control.controllers import ARTIFACT_CONTROLLERS, BASELINE_CONTROLLERS, CONTROLLERS, DP_CONTROLLERS
 from host.control.dp_controller import load_tables
 from host.errors import HostError
+from host.outputs import check_output_folder, json_marker_owner
 from host.sim.metrics import ImagingPlan
 from host.sim.simulator import SimConfig
 from host.sim.targets import parse_target
@@ -26,6 +27,7 @@ DEFAULT_DURATION_S = 100.0
 MAX_DURATION_S = 100_000.0    # a staring pass lasts minutes; this bounds memory (histories) too
 MIN_PERIOD_S, MAX_PERIOD_S = 1e-4, 10.0
 MIN_DT_S = 1e-6
+OWNED = json_marker_owner("metrics.json")   # an earlier simulation's folder: replaced as a whole
 
 
 def register(subparsers) -> None:
@@ -57,23 +59,6 @@ def register(subparsers) -> None:
     p.set_defaults(func=main)
 
 
-def check_output_folder(out: Path, marker: str = "metrics.json") -> None:
-    """The folder must be creatable or replaceable: not a file, its parent a directory, and, if it
-    exists with content, a previous output of this command (holding `marker`) — the atomic
-    write replaces the whole folder, so `--out ~` must never be accepted."""
-    if out.exists() and not out.is_dir():
-        raise HostError(f"output folder {out} exists and is not a directory")
-    if out.is_dir() and any(out.iterdir()) and not (out / marker).is_file():
-        raise HostError(f"output folder {out} exists, is not empty and holds no {marker}; "
-                        "refusing to replace it (choose a new or empty folder)")
-    parent = out.resolve().parent
-    for p in [parent, *parent.parents]:
-        if p.exists():
-            if not p.is_dir():
-                raise HostError(f"cannot create output folder {out}: {p} is not a directory")
-            break
-
-
 def build_config(args, errors) -> SimConfig:
     return SimConfig(duration=parse_number(args.duration, "--duration", positive=True, maximum=MAX_DURATION_S),
                      seed=parse_int(args.seed, "--seed"), errors=errors)
@@ -98,7 +83,7 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     dt = parse_number(args.dt or str(tanh_example.MAX_REFERENCE_STEP), "--dt", positive=True, minimum=MIN_DT_S,
                       maximum=MAX_PERIOD_S)
     out = Path(args.out)
-    check_output_folder(out)
+    check_output_folder(out, OWNED)
     try:
         with atomic.directory(out) as tmp:
             if in_loop:
@@ -163,7 +148,7 @@ def main(args: argparse.Namespace) -> int:
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
     options = controller_options(args)
     out = Path(args.out)
-    check_output_folder(out)
+    check_output_folder(out, OWNED, [args.artifact, args.baselines, args.tables, args.scenario])
     validate_campaign(args.controller, targets, config, plan, options)
     try:
         with atomic.directory(out) as tmp:

@@ -34,6 +34,7 @@ from codegen import atomic
 from codegen.package import config as pc
 from host.control.pid import TABLE1_GAINS
 from host.errors import HostError
+from host.outputs import check_output_folder, file_marker_owner
 from host.learn.samples import npz_bytes
 from host.learn.shards import check_place, read_bound_npz, read_json
 from host.sim.batched import GainSets, simulate_pid_batch
@@ -173,9 +174,8 @@ def open_directory(directory: Path, plan: TuningPlan) -> list[int]:
         if old.get("plan_hash") != plan.plan_hash():
             raise HostError(f"{directory} holds a tuning run of another plan (grid, targets, seeds, duration or "
                             "shard size differ); use another --out")
-    else:
-        if directory.exists() and not directory.is_dir():
-            raise HostError(f"{directory} exists and is not a directory")
+    else:   # a new tuning folder: never one holding files of something else
+        check_output_folder(directory, file_marker_owner(PLAN_FILE), replaced=False)
         atomic.write_json(path, {**plan.as_dict(), "plan_hash": plan.plan_hash()})
     for tmp in directory.glob(".shard-*.tmp"):
         tmp.unlink(missing_ok=True)
@@ -262,8 +262,8 @@ def tune(directory, plan: TuningPlan, base_config: pc.PackageConfig, scheduler: 
 
     directory = Path(directory)
     start = time.perf_counter()
+    done = set(open_directory(directory, plan))   # a folder that is not a tuning folder: refused before any cluster
     with dask_client(scheduler, workers, processes=processes) as client:
-        done = set(open_directory(directory, plan))
         todo = [i for i in range(plan.n_shards) if i not in done]
         per_scenario = len(plan.targets) * len(plan.seeds)
         weights = [(plan.shard_range(i)[1] - plan.shard_range(i)[0]) * per_scenario for i in todo]

@@ -165,6 +165,15 @@ CASES = [
     (["calibrate", "--network", "{net}", "--scales", "-1", "--out", "{tmp}/c"], "--scales"),
     (["calibrate", "--network", "{net}", "--targets", "3", "--response-targets", "5", "--out", "{tmp}/c"],
      "--response-targets"),
+    # issue 25 (data loss)
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}"], "lies inside output folder"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "."], "is the current folder or holds it"),
+    (["simulate", "--controller", "nn", "--artifact", "{net}", "--out", "{tmp}"], "lies inside output folder"),
+    (["simulate", "--out", ".."], "is the current folder or holds it"),
+    (["impulse", "--artifact", "{net}", "--out", "{tmp}"], "lies inside output folder"),
+    (["pipeline", "--out", "."], "is the current folder or holds it"),
+    (["tune", "pid", "--grid", "kp=17,ki=0,kd=46", "--targets", "1", "--duration", "11", "--out", "{tmp}"],
+     "holds no tuning.json"),
 ]
 
 
