@@ -188,23 +188,25 @@ def scratch(path: str | os.PathLike) -> Iterator[Path]:
 
 
 def _move_in(tmp: Path, path: Path) -> None:
-    """Replace folder `path` by `tmp`; the old folder goes to a fresh temporary of this run, and
-    comes back if the second rename fails."""
+    """Replace `path` by folder `tmp`; the old entry goes into a fresh temporary of this run (removed
+    after), and comes back if the second rename fails."""
     if not path.exists() and not path.is_symlink():
         os.replace(tmp, path)
         return
-    old = Path(tempfile.mkdtemp(prefix=_temp_prefix(path), suffix=".old", dir=path.parent))
+    old_dir = Path(tempfile.mkdtemp(prefix=_temp_prefix(path), suffix=".old", dir=path.parent))
+    old = old_dir / path.name
     try:
-        os.replace(path, old)   # onto the empty folder mkdtemp made: allowed for folders
+        os.replace(path, old)
     except BaseException:
-        old.rmdir()
+        old_dir.rmdir()
         raise
     try:
         os.replace(tmp, path)
     except BaseException:
         os.replace(old, path)
+        old_dir.rmdir()
         raise
-    shutil.rmtree(old, ignore_errors=True)
+    shutil.rmtree(old_dir, ignore_errors=True)
 
 
 @contextmanager

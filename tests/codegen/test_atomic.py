@@ -134,3 +134,15 @@ def test_the_current_folder_is_refused_in_one_line(tmp_path, monkeypatch):
         with atomic.directory(".") as tmp:
             (tmp / "f").write_text("1")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_symlinked_output_is_replaced_and_its_target_kept(tmp_path):
+    target = tmp_path / "target"
+    target.mkdir()
+    (target / "keep.txt").write_text("kept")
+    (tmp_path / "out").symlink_to(target)
+    with atomic.directory(tmp_path / "out") as tmp:
+        (tmp / "f").write_text("1")
+    assert not (tmp_path / "out").is_symlink() and (tmp_path / "out" / "f").read_text() == "1"
+    assert (target / "keep.txt").read_text() == "kept"
+    assert sorted(x.name for x in tmp_path.iterdir()) == ["out", "target"]
