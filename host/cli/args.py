@@ -47,6 +47,14 @@ def parse_number(text: str, what: str, *, positive: bool = False, non_negative: 
     return value
 
 
+def parse_response_targets(text: str, n_targets: int) -> int:
+    """--response-targets of evaluate and calibrate: `all` (the default) is every staring target, so
+    `--targets central` works with the defaults; an explicit count above the targets stays an error."""
+    if text.strip().lower() == "all":
+        return n_targets
+    return parse_int(text, "--response-targets", minimum=1, maximum=n_targets)
+
+
 SCENARIO_HELP = ("scenario file (`staregen scenario init`): the reading of Table 6's sensor and wheel errors "
                  f"(default: the built-in `{scenario_file.DEFAULT_READING}` reading, chosen by `staregen calibrate`)")
 
