@@ -8,7 +8,7 @@ import html
 import re
 
 INLINE_MARKUP = re.compile(r"([\\`*_\[\]|~])")       # escapes, code spans, emphasis, links, cells, strike
-BLOCK_MARKER = re.compile(r"[#+=-]|[0-9]+[.)]")      # heading, list item, setext rule, ordered list
+BLOCK_MARKER = re.compile(r"(?:#+|[+=-]|[0-9]+[.)])(?= |$)")    # heading, list item, setext rule, ordered list
 
 
 def escape(text) -> str:
@@ -19,6 +19,4 @@ def escape(text) -> str:
     s = "".join(c if c.isprintable() else "\ufffd" for c in s)
     s = html.escape(INLINE_MARKUP.sub(r"\\\1", s), quote=False)
     m = BLOCK_MARKER.match(s)
-    if m:
-        s = s[:m.end() - 1] + "\\" + s[m.end() - 1:]
-    return s
+    return s[:m.end() - 1] + "\\" + s[m.end() - 1:] if m else s     # `12\. x`: a digit takes no backslash
