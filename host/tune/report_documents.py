@@ -67,8 +67,8 @@ CALIBRATION = {
     "nn_to_pid_ratio": MapOf(REAL), "paper_nn_to_pid_ratio": POSITIVE,
     "scale_fit?": Maybe({"reading": TEXT, "scale": REAL, "residual": REAL,
                          "prediction": MapOf({"central": PAIR, "all": PAIR}), "nn_to_pid_ratio": MapOf(REAL)}),
-    "step_model?": Maybe({"laws?": MapOf({"kp": XYZ, "kd": XYZ, "settling_s": XYZ}),
-                          "critically_damped_for_paper_nn_settling?": {"settling_s": XYZ, "kp": XYZ, "kd": XYZ}}),
+    "step_model?": Maybe({"laws": MapOf({"kp": XYZ, "kd": XYZ, "settling_s": XYZ}),
+                          "critically_damped_for_paper_nn_settling": {"settling_s": XYZ, "kp": XYZ, "kd": XYZ}}),
 }
 
 

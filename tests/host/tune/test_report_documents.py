@@ -97,16 +97,34 @@ def test_a_malformed_tuning_result_is_one_line_naming_the_field(tmp_path, capsys
     assert not (tmp_path / "r").exists()
 
 
-def test_a_calibration_without_the_labelled_rows_is_one_line(tmp_path, capsys):
+PAIR = {w: dict(ROW) for w in ("central", "all")}
+CALIBRATION = {"labels": {"table1": "PID (Table 1)", "tuned": None, "network": "NN (float64)"},
+               "candidates": [{"reading": "table6", "residual": 0.2, "ratios": {"central J_A": 1.0}}],
+               "chosen": "table6", "prediction": {"staring": {"PID (Table 1)": PAIR, "NN (float64)": PAIR}},
+               "nn_to_pid_ratio": {}, "paper_nn_to_pid_ratio": 0.658}
+
+
+@pytest.mark.parametrize("edit, message", [
+    (("prediction.staring", {"PID (Table 1)": PAIR}), "no row for labels.network 'NN (float64)'"),
+    (("candidates", []), "candidates: must be a list of values (at least 1)"),
+    (("step_model", {"laws": {}}), "step_model.critically_damped_for_paper_nn_settling: missing"),
+    (("paper_nn_to_pid_ratio", "0.658"), "paper_nn_to_pid_ratio: must be a number > 0"),
+])
+def test_a_malformed_calibration_is_one_line_naming_the_field(tmp_path, capsys, edit, message):
     ev = folder(tmp_path, "ev", "evaluate.json", evaluation())
-    pair = {w: dict(ROW) for w in ("central", "all")}
-    cal = {"labels": {"table1": "PID (Table 1)", "tuned": None, "network": "NN (float64)"},
-           "candidates": [{"reading": "table6", "residual": 0.2, "ratios": {"central J_A": 1.0}}], "chosen": "table6",
-           "prediction": {"staring": {"PID (Table 1)": pair}}, "nn_to_pid_ratio": {}, "paper_nn_to_pid_ratio": 0.658}
-    cal_dir = folder(tmp_path, "cal", "calibration.json", cal)
+    cal_dir = folder(tmp_path, "cal", "calibration.json", _edit(CALIBRATION, *edit))
     code, err = run_report(capsys, "--evaluate", ev, "--calibration", cal_dir, "--out", str(tmp_path / "r"))
-    assert code == 2 and err.count("\n") == 1 and "no row for labels.network 'NN (float64)'" in err, err
+    assert code == 2 and err.count("\n") == 1 and "calibration.json: not written by `staregen calibrate`" in err, err
+    assert message in err, err
     assert not (tmp_path / "r").exists()
+
+
+def test_a_well_formed_calibration_is_reported(tmp_path, capsys):
+    ev = folder(tmp_path, "ev", "evaluate.json", evaluation())
+    cal_dir = folder(tmp_path, "cal", "calibration.json", CALIBRATION)
+    code, err = run_report(capsys, "--evaluate", ev, "--calibration", cal_dir, "--out", str(tmp_path / "r"))
+    assert code == 0, err
+    assert "## Fidelity to paper 001" in (tmp_path / "r" / "report.md").read_text()
 
 
 HOSTILE = "x\n## injected <script>alert(1)</script> [link](javascript:alert(1)) *bold* `code`"
