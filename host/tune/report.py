@@ -354,8 +354,7 @@ def _read_figure(path: Path) -> bytes | None:
 
 
 def _read_inputs(evaluate_dir: Path, tune_dir: Path | None, calibration_dir: Path | None) -> dict:
-    """Every input of the report, checked, before anything is written."""
-    figures = {name: _read_figure(evaluate_dir / name) for name in FIGURES}
+    """Every input of the report, checked, before anything is written (the documents first)."""
     return {
         "evaluation": documents.read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)",
                                      documents.EVALUATION, "staregen evaluate"),
@@ -363,7 +362,7 @@ def _read_inputs(evaluate_dir: Path, tune_dir: Path | None, calibration_dir: Pat
                                  "staregen tune pid") if tune_dir else None,
         "calibration": documents.read(calibration_dir / "calibration.json", "calibration (calibration.json)",
                                       documents.CALIBRATION, "staregen calibrate") if calibration_dir else None,
-        "figures": {name: data for name, data in figures.items() if data is not None},
+        "figures": {name: data for name in FIGURES if (data := _read_figure(evaluate_dir / name)) is not None},
         "calibration_figure": _read_figure(calibration_dir / "fig_ratio_vs_noise.png") if calibration_dir else None,
     }
 

@@ -177,15 +177,17 @@ CASES = [
     (["report", "--evaluate", "{ev_link}", "--out", "{tmp}/r"], "fig10_scatter.png: not embedded: not a regular file"),
     (["report", "--command", "staregen evaluate", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"],
      "staregen report: error: --evaluate"),
-    (["tune", "pid", "--targets", "central", "--out", "{tune_list}"], "tuning.json: the tuning plan is not a JSON object"),
+    (["tune", "pid", "--targets", "central", "--out", "{tune_list}"],
+     "tuning.json: the tuning plan is not a JSON object"),
     (["tune", "pid", "--grid", "kp=1.7e308,ki=0,kd=40", "--targets", "central", "--duration", "12", "--out", "{tmp}/t"],
      "--grid kp: a value the controller configuration cannot hold"),
     (["tune", "pid", "--grid", "kp=1_0,ki=0,kd=40", "--duration", "5", "--out", "{tmp}/t"], "grid kp=1_0"),
     (["tune", "pid", "--targets", "{targets_underscore}", "--duration", "5", "--out", "{tmp}/t"], ":1: unknown target"),
     (["simulate", "--target", "1_20,3_0", "--t-img", "0", "--out", "{tmp}/o"], "unknown target '1_20,3_0'"),
-    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--gate-vectors", "1_00", "--vectors", "0"],
-     "--gate-vectors must be an integer in ASCII digits"),
-    (["verify", "--artifact", "{net}", "--vectors", " \u0664 ", "--steps", "2"], "--vectors must be an integer in ASCII digits"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--gate-vectors", "1_00",
+      "--vectors", "0"], "--gate-vectors must be an integer in ASCII digits"),
+    (["verify", "--artifact", "{net}", "--vectors", " \u0664 ", "--steps", "2"],
+     "--vectors must be an integer in ASCII digits"),
     (["artifact", "random", "--shape", "\u0661\u0662-40-3", "--out", "{tmp}/a.json"], "--shape"),
     (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "--shape 10000-10000-10000"),
     (["dp", "build", "--data", "{tmp}/none", "--n-max", "1_000", "--out", "{tmp}/t.json"], "--n-max"),
@@ -217,7 +219,8 @@ def _issue25_files(folder) -> dict[str, str]:
             "frequency": {"PID (Table 1)": {"freqs_hz": [1.0], "amplitude_deg": [[1e-3]] * 3}},
             "plan": {"targets": 1, "duration": 12.0, "response_targets": 1, "freqs_hz": [1.0], "seed": 0}}
     docs = {"ev_good": good, "ev_lists": {"staring": [], "step": {}, "frequency": {}},
-            "ev_row": {**good, "staring": {"PID (Table 1)": {}}}, "ev_plan": {**good, "plan": {**good["plan"], "duration": "b"}},
+            "ev_row": {**good, "staring": {"PID (Table 1)": {}}},
+            "ev_plan": {**good, "plan": {**good["plan"], "duration": "b"}},
             "ev_zero": {**good, "staring": {"PID (Table 1)": {**row, "J": 0}}}, "ev_link": good}
     out = {}
     for name, doc in docs.items():
