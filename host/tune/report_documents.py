@@ -72,8 +72,11 @@ CALIBRATION = {
 }
 
 
-def _label(key) -> str:
-    text = repr(key)
+def _label(value) -> str:
+    """A value for an error line: short, on one line (a container by its type)."""
+    if isinstance(value, (dict, list)):
+        return f"a {'list' if isinstance(value, list) else 'JSON object'}"
+    text = repr(value[:40] if isinstance(value, str) else value)
     return text if len(text) <= 32 else text[:29] + "..."
 
 
@@ -99,13 +102,7 @@ def check(value, shape, field: str) -> None:
         if not _scalar(value, shape):
             raise HostError(f"{field or 'the document'}: must be {shape}, got {_label(value)}")
     elif isinstance(shape, ListOf):
-        if not isinstance(value, list) or (shape.length is not None and len(value) != shape.length) \
-                or len(value) < shape.min_length:
-            size = f"{shape.length} " if shape.length is not None else ""
-            raise HostError(f"{field or 'the document'}: must be a list of {size}values"
-                            + (f" (at least {shape.min_length})" if shape.min_length else ""))
-        for i, item in enumerate(value):
-            check(item, shape.item, f"{field}[{i}]")
+        _check_list(value, shape, field)
     elif isinstance(shape, MapOf):
         if not isinstance(value, dict):
             raise HostError(f"{field or 'the document'}: must be an object (label: value), got {_label(value)}")
@@ -113,6 +110,16 @@ def check(value, shape, field: str) -> None:
             check(item, shape.item, f"{field}[{_label(key)}]")
     else:
         _check_fields(value, shape, field)
+
+
+def _check_list(value, shape: ListOf, field: str) -> None:
+    if not isinstance(value, list) or (shape.length is not None and len(value) != shape.length) \
+            or len(value) < shape.min_length:
+        size = f"{shape.length} " if shape.length is not None else ""
+        raise HostError(f"{field or 'the document'}: must be a list of {size}values"
+                        + (f" (at least {shape.min_length})" if shape.min_length else ""))
+    for i, item in enumerate(value):
+        check(item, shape.item, f"{field}[{i}]")
 
 
 def _check_fields(value, shape: dict, field: str) -> None:
