@@ -76,7 +76,12 @@ def write_text(path: str | os.PathLike, text: str) -> Path:
 
 
 def write_json(path: str | os.PathLike, obj, indent: int = 2) -> Path:
-    return write_text(path, json.dumps(obj, indent=indent, sort_keys=False) + "\n")
+    """Strict JSON: a NaN or infinity is refused (json.dumps would write a bare NaN, which no JSON reader takes)."""
+    try:
+        text = json.dumps(obj, indent=indent, sort_keys=False, allow_nan=False)
+    except ValueError:
+        raise CodegenError(f"{path}: not written: a value is NaN or infinite, which JSON cannot hold") from None
+    return write_text(path, text + "\n")
 
 
 @contextmanager

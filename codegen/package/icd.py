@@ -15,6 +15,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION
 from codegen.cgen import check_name, environment
 from codegen.errors import CodegenError
+from codegen.markdown import escape as markdown_escape
 from codegen.unit import Unit
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -132,7 +133,9 @@ def _config_rows(config: dict) -> list[tuple[str, str]]:
 
 
 def _inputs(config: dict) -> list[tuple[str, str, str]]:
-    return [(cell(k), cell(v.get("file", "")), cell(str(v.get("sha256", ""))[:16]))
+    """(role, file name, sha256 prefix): a file may be named `<img src=x onerror=...>.json`, so its
+    name is escaped for Markdown and the HTML a renderer passes through, not only kept in its cell."""
+    return [(markdown_escape(k), markdown_escape(v.get("file", "")), cell(str(v.get("sha256", ""))[:16]))
             for k, v in config.get("inputs", {}).items() if isinstance(v, dict)]
 
 

@@ -3,15 +3,23 @@ from __future__ import annotations
 
 import math
 
+from codegen import number_text
 from host.errors import HostError
 from host.sim import scenario_file
 
 
+def shown(text) -> str:
+    """A user's text for an error line: quoted, at most 40 characters."""
+    s = repr(text)
+    return s if len(s) <= 40 else s[:37] + "..."
+
+
 def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None) -> int:
+    """An integer in ASCII digits (codegen.number_text: no `1_00`, no Arabic-Indic digits) within bounds."""
     try:
-        value = int(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be an integer, got {text!r}") from None
+        value = number_text.parse_integer(text)
+    except ValueError:
+        raise HostError(f"{what} must be an integer in ASCII digits, got {shown(text)}") from None
     if value < minimum:
         raise HostError(f"{what} must be at least {minimum}, got {value}")
     if maximum is not None and value > maximum:
@@ -21,12 +29,13 @@ def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None
 
 def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False,
                  minimum: float | None = None, maximum: float | None = None) -> float:
+    """A real in ASCII digits (codegen.number_text) within bounds."""
     try:
-        value = float(text)
-    except (TypeError, ValueError):
-        raise HostError(f"{what} must be a number, got {text!r}") from None
+        value = number_text.parse_real(text)
+    except ValueError:
+        raise HostError(f"{what} must be a number in ASCII digits, got {shown(text)}") from None
     if not math.isfinite(value):
-        raise HostError(f"{what} must be finite, got {text!r}")
+        raise HostError(f"{what} must be finite, got {shown(text)}")
     if positive and value <= 0:
         raise HostError(f"{what} must be positive, got {text}")
     if non_negative and value < 0:
@@ -36,6 +45,14 @@ def parse_number(text: str, what: str, *, positive: bool = False, non_negative: 
     if maximum is not None and value > maximum:
         raise HostError(f"{what} must be at most {maximum:g}, got {text}")
     return value
+
+
+def parse_response_targets(text: str, n_targets: int) -> int:
+    """--response-targets of evaluate and calibrate: `all` (the default) is every staring target, so
+    `--targets central` works with the defaults; an explicit count above the targets stays an error."""
+    if text.strip().lower() == "all":
+        return n_targets
+    return parse_int(text, "--response-targets", minimum=1, maximum=n_targets)
 
 
 SCENARIO_HELP = ("scenario file (`staregen scenario init`): the reading of Table 6's sensor and wheel errors "

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen.package import config as pc
-from host.cli.args import parse_int, parse_number
+from host.cli.args import parse_int, parse_number, parse_response_targets
 from host.cli.tune import parse_targets
 from host.control.baselines import load_baselines
 from host.errors import HostError
@@ -62,8 +62,7 @@ def run(args: argparse.Namespace) -> int:
     if a.sizes[0] != 12 or a.sizes[-1] != 3:
         raise HostError(f"--network: the network controller needs a 12-input, 3-output network, got {a.shape_text}")
     targets = parse_targets(args.targets)
-    n_resp = len(targets) if args.response_targets.strip().lower() == "all" else parse_int(
-        args.response_targets, "--response-targets", minimum=1, maximum=len(targets))
+    n_resp = parse_response_targets(args.response_targets, len(targets))
     c = central_target()
     plan = cal.CalibrationPlan(targets=targets, central=(c.name, c.lon, c.lat, 0), readings=parse_readings(args.readings),
                                duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),

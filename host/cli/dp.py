@@ -89,15 +89,15 @@ def build_main(args) -> int:
     params = DpParams(r=parse_number(args.r, "--r", positive=True), s_limit=parse_int(args.s_limit, "--s-limit", 1),
                       n_min=parse_int(args.n_min, "--n-min", 1), widen=parse_number(args.widen, "--widen"),
                       iterations=parse_int(args.iterations, "--iterations", 0)).validate()
+    seed = parse_int(args.seed, "--seed", 0)
+    n_max = None if args.n_max is None else parse_int(args.n_max, "--n-max", 1)   # every flag before the data
     out = Path(args.out)
     if not out.parent.is_dir():
         raise HostError(f"--out: folder {out.parent} does not exist")
     X, Y, _ = training.load_training_data(args.data)
-    seed = parse_int(args.seed, "--seed", 0)
     split = training.make_split(X, Y, seed)
     Xt, Yt = split.X_train, split.Y_train
-    if args.n_max is not None:
-        n_max = parse_int(args.n_max, "--n-max", 1)
+    if n_max is not None:
         Xt, Yt = Xt[:n_max], Yt[:n_max]
     problem = dp_tables.flash_problem(len(Xt))
     if problem:

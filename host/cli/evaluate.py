@@ -17,7 +17,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen.package import config as pc
-from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number, parse_response_targets
 from host.cli.tune import parse_targets
 from host.control.baselines import load_baselines
 from host.errors import HostError
@@ -129,8 +129,7 @@ def build_plan(args, errors) -> EvalPlan:
                         freqs=QUICK["freqs"], freq_duration=QUICK["freq_duration"], errors=errors,
                         engine=args.engine, preset="quick")
     targets = parse_targets(args.targets)
-    n_resp = len(targets) if args.response_targets.strip().lower() == "all" else parse_int(
-        args.response_targets, "--response-targets", minimum=1, maximum=len(targets))
+    n_resp = parse_response_targets(args.response_targets, len(targets))
     return EvalPlan(targets=targets, response_targets=targets[:n_resp], central=central,
                     duration=parse_number(args.duration, "--duration", minimum=11.0, maximum=86400.0),
                     seed=parse_int(args.seed, "--seed", maximum=2**32 - 1), freqs=parse_freqs(args.freqs),

@@ -16,7 +16,9 @@ def register(subparsers) -> None:
     p.add_argument("--tune", default=None, metavar="DIR", help="folder written by `staregen tune pid`")
     p.add_argument("--calibration", default=None, metavar="DIR",
                    help="folder written by `staregen calibrate` (adds the section 'Fidelity to paper 001')")
-    p.add_argument("--command", action="append", default=[], help="a command of the run, to list (repeatable)")
+    # dest "commands": "command" is the subcommand's name, which the one-line error prints
+    p.add_argument("--command", dest="commands", action="append", default=[],
+                   help="a command of the run, to list (repeatable)")
     p.add_argument("--out", required=True, help="report folder (created)")
     p.set_defaults(func=run)
 
@@ -34,6 +36,6 @@ def run(args: argparse.Namespace) -> int:
     cal_dir = Path(args.calibration) if args.calibration else None
     if cal_dir is not None and not cal_dir.is_dir():
         raise HostError(f"--calibration {cal_dir}: not a folder")
-    paths = write_report(out, evaluate_dir, tune_dir, args.command, cal_dir)
+    paths = write_report(out, evaluate_dir, tune_dir, args.commands, cal_dir)
     print(f"wrote {paths['md']} and {paths['html']}")
     return 0

@@ -12,10 +12,18 @@ from host.errors import HostError
 
 
 def read_json(path: Path, what: str) -> dict:
+    """A JSON object (strict: no NaN or Infinity), or a one-line HostError naming the file."""
     try:
-        return json.loads(Path(path).read_text())
+        doc = json.loads(Path(path).read_text(), parse_constant=_refuse_constant)
     except (OSError, ValueError) as exc:
         raise HostError(f"{path}: unreadable {what} ({type(exc).__name__})") from None
+    if not isinstance(doc, dict):
+        raise HostError(f"{path}: the {what} is not a JSON object (got a {type(doc).__name__})")
+    return doc
+
+
+def _refuse_constant(name: str):
+    raise ValueError(f"{name} is not JSON")
 
 
 def check_place(json_path: Path, sidecar: dict, place: dict, index: int, owner: str) -> None:

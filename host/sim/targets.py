@@ -16,6 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from codegen.number_text import parse_real
 from host.core.constants import DEG, EARTH_MEAN_RADIUS
 from host.errors import HostError
 
@@ -93,7 +94,7 @@ def parse_target(text: str) -> list[Target]:
     try:
         if len(parts) != 2:
             raise ValueError
-        lon_deg, lat_deg = float(parts[0]), float(parts[1])
+        lon_deg, lat_deg = parse_real(parts[0]), parse_real(parts[1])   # ASCII digits: no `1_20`
     except ValueError:
         raise HostError(f"unknown target {text!r}: expected 'central', 'all' or 'LON,LAT' in degrees") from None
     if not (np.isfinite(lon_deg) and np.isfinite(lat_deg)):

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from codegen.number_text import parse_real
 from host.errors import HostError
 
 
@@ -78,7 +79,7 @@ def _axis_values(key: str, spec: str) -> tuple[float, ...]:
     """`V` or `LO:HI:STEP` (both ends included when HI lies on the step)."""
     parts = spec.split(":")
     try:
-        nums = [float(p) for p in parts]
+        nums = [parse_real(p) for p in parts]   # ASCII digits: no `1_0`
     except ValueError:
         raise HostError(f"grid {key}={spec}: expected a number or LO:HI:STEP") from None
     if len(nums) not in (1, 3) or not all(np.isfinite(nums)):

@@ -132,7 +132,13 @@ def shard_paths(directory: Path, index: int) -> tuple[Path, Path]:
 
 
 def write_shard(directory: Path, plan: TuningPlan, result: dict) -> None:
-    index, data = result["index"], npz_bytes(result["arrays"])
+    index, arrays = result["index"], result["arrays"]
+    bad = ~(np.isfinite(arrays["J_A_axis"]) & np.isfinite(arrays["J_w_axis"])).all(axis=(0, 2, 3))
+    if bad.any():   # a shard read back refuses it as corrupt; say which gains diverged instead
+        kp, ki, kd = arrays["triples"][int(np.argmax(bad))]
+        raise HostError(f"tuning shard {index}: the triple Kp {kp:g}, Ki {ki:g}, Kd {kd:g} gives a NaN or infinite "
+                        "objective; leave it out of --grid")
+    data = npz_bytes(arrays)
     npz_path, json_path = shard_paths(directory, index)
     atomic.write_bytes(npz_path, data)
     start, stop = plan.shard_range(index)
@@ -160,20 +166,26 @@ def read_shard(directory: Path, plan: TuningPlan, index: int) -> dict:
             or arrays["J_A_axis"].shape != (*shape, 3) or arrays["J_w_axis"].shape != (*shape, 3)):
         raise HostError(f"{npz_path}: its triples or shapes are not shard {index}'s (a swapped shard); "
                         f"delete {npz_path.name} and {json_path.name} to recompute it")
+    # argmin would pick a NaN as the best triple and write it to result.json: a corrupt shard
+    if not all(np.isfinite(arrays[k]).all() for k in ("J_A_axis", "J_w_axis")):
+        raise HostError(f"{npz_path}: corrupt: an objective is NaN or infinite; "
+                        f"delete {npz_path.name} and {json_path.name} to recompute it")
     return arrays
+
+
+def check_existing_plan(directory: Path, plan: TuningPlan) -> None:
+    """A tuning folder's plan file, when there is one, is a JSON object of this plan."""
+    path = directory / PLAN_FILE
+    if path.exists() and read_json(path, "tuning plan").get("plan_hash") != plan.plan_hash():
+        raise HostError(f"{directory} holds a tuning run of another plan (grid, targets, seeds, duration or "
+                        "shard size differ); use another --out")
 
 
 def open_directory(directory: Path, plan: TuningPlan) -> list[int]:
     """Create the directory and its plan, or check an existing one; returns the finished shards."""
     path = directory / PLAN_FILE
     if path.exists():
-        try:
-            old = json.loads(path.read_text())
-        except (OSError, ValueError):
-            raise HostError(f"{path}: unreadable tuning plan") from None
-        if old.get("plan_hash") != plan.plan_hash():
-            raise HostError(f"{directory} holds a tuning run of another plan (grid, targets, seeds, duration or "
-                            "shard size differ); use another --out")
+        check_existing_plan(directory, plan)
     else:   # a new tuning folder: never one holding files of something else
         check_output_folder(directory, file_marker_owner(PLAN_FILE), replaced=False)
         atomic.write_json(path, {**plan.as_dict(), "plan_hash": plan.plan_hash()})
@@ -231,6 +243,22 @@ def check_run(plan: TuningPlan, result: TuningResult) -> dict:
     return out
 
 
+def check_grid_fits(grid: PidGrid, base: pc.PackageConfig) -> None:
+    """Every gain of the grid is one the configuration can hold: each distinct value put in `base`'s
+    PID gains and validated by the configuration's own rules (as tuned_config will, but before a
+    shard runs, not after the whole grid)."""
+    data = base.to_mapping()
+    for key in ("kp", "ki", "kd"):
+        values = sorted(set(getattr(grid, key)))
+        for i in range(0, len(values), 3):       # three values per trial: a gain is a vec3
+            chunk = values[i:i + 3]
+            try:
+                pc.from_mapping({**data, "pid": {**data["pid"], key: chunk + chunk[-1:] * (3 - len(chunk))}},
+                                sealed=False)
+            except pc.ConfigError as exc:
+                raise HostError(f"--grid {key}: a value the controller configuration cannot hold ({exc})") from None
+
+
 def tuned_config(result: TuningResult, base: pc.PackageConfig) -> pc.PackageConfig:
     """The configuration with the tuned gains in place of its PID gains (everything else kept)."""
     data = base.to_mapping()
@@ -261,6 +289,8 @@ def tune(directory, plan: TuningPlan, base_config: pc.PackageConfig, scheduler: 
     from host.learn.distributed import dask_client, run_tasks
 
     directory = Path(directory)
+    check_grid_fits(plan.grid, base_config)
+    check_existing_plan(directory, plan)      # before any worker starts
     start = time.perf_counter()
     done = set(open_directory(directory, plan))   # a folder that is not a tuning folder: refused before any cluster
     with dask_client(scheduler, workers, processes=processes) as client:

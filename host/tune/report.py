@@ -3,22 +3,28 @@ numbers beside ours and a one-line reading of every difference; Markdown (report
 it) and one self-contained HTML page (report.html, images embedded as data URIs).
 
 The document is built once as a list of blocks (heading, paragraph, table, image) and rendered
-twice, so the two files cannot disagree. Every string from an input file is escaped for HTML.
+twice, so the two files cannot disagree. Every string from an input file or the command line is
+escaped: for HTML in report.html, by codegen.markdown.escape in report.md. The input documents are
+checked against the shapes the report uses (host.tune.report_documents) before anything is written,
+and a figure is embedded only from a regular PNG file (a symbolic link is not followed).
 """
 from __future__ import annotations
 
 import base64
 import html
 import json
+import os
 import platform
-import shutil
+import stat
 from dataclasses import dataclass
 from datetime import datetime, timezone
 from pathlib import Path
 
 from codegen import atomic
+from codegen.markdown import escape as markdown_escape
 from host.errors import HostError
 from host.tune import paper001
+from host.tune import report_documents as documents
 
 PAPER_TABLE8, PAPER_TABLE9, PAPER_STEP = paper001.TABLE8, paper001.TABLE9, paper001.STEP
 STEP_NAMES = {"overshoot_pct": "overshoot [%]", "settling_s": "settling time [s]",
@@ -32,15 +38,6 @@ class Block:
     header: tuple = ()
     rows: tuple = ()
     path: str = ""
-
-
-def _read(path: Path, what: str) -> dict:
-    try:
-        return json.loads(Path(path).read_text())
-    except OSError as exc:
-        raise HostError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
-    except ValueError:
-        raise HostError(f"{path}: the {what} is not valid JSON") from None
 
 
 def _g(x) -> str:
@@ -287,8 +284,8 @@ def build(evaluation: dict, tuning: dict | None, figures: dict[str, Path], run_f
 
 
 def _md(text) -> str:
-    """Text for Markdown: HTML special characters as entities (a renderer passes raw HTML through)."""
-    return html.escape(str(text), quote=False)
+    """Text for Markdown: one literal line (codegen.markdown.escape: no markup, no raw HTML, no new block)."""
+    return markdown_escape(text)
 
 
 def to_markdown(blocks: list[Block]) -> str:
@@ -301,7 +298,7 @@ def to_markdown(blocks: list[Block]) -> str:
         elif b.kind == "p":
             out.append(_md(b.text) + "\n")
         elif b.kind == "table":
-            cells = [[_md(c).replace("|", "\\|") for c in row] for row in (b.header, *b.rows)]
+            cells = [[_md(c) for c in row] for row in (b.header, *b.rows)]
             out.append("| " + " | ".join(cells[0]) + " |\n|" + "---|" * len(cells[0]) + "\n"
                        + "".join("| " + " | ".join(r) + " |\n" for r in cells[1:]))
         elif b.kind == "img":
@@ -332,38 +329,53 @@ def to_html(blocks: list[Block]) -> str:
             f"<style>{style}</style></head><body>\n" + "\n".join(body) + "\n</body></html>\n")
 
 
-def _copy_figure(src: Path, dst: Path) -> Path:
-    if src.resolve() != dst.resolve():
-        with atomic.writing(dst, suffix=".png") as tmp:
-            shutil.copyfile(src, tmp)
-    return dst
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+MAX_FIGURE_BYTES = 64 << 20
+FIGURES = ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png")
 
 
-def _read_calibration(folder: Path) -> dict:
-    doc = _read(folder / "calibration.json", "calibration (calibration.json)")
-    keys = {"candidates", "chosen", "prediction", "labels", "nn_to_pid_ratio", "paper_nn_to_pid_ratio"}
-    if not isinstance(doc, dict) or not keys <= set(doc):
-        raise HostError(f"{folder / 'calibration.json'}: not written by `staregen calibrate`")
-    return doc
+def _read_figure(path: Path) -> bytes | None:
+    """The bytes of a figure to embed, None when there is none. Only a regular file that starts with
+    the PNG signature: a symbolic link is not followed (`fig10_scatter.png -> /etc/passwd` would put
+    that file into report.html), nor is a FIFO or device opened for long."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raise HostError(f"{path}: not embedded: not a regular file ({exc.strerror or exc})") from None
+    with os.fdopen(fd, "rb") as fh:
+        if not stat.S_ISREG(os.fstat(fh.fileno()).st_mode):
+            raise HostError(f"{path}: not embedded: not a regular file")
+        data = fh.read(MAX_FIGURE_BYTES + 1)
+    if len(data) > MAX_FIGURE_BYTES or not data.startswith(PNG_SIGNATURE):
+        raise HostError(f"{path}: not embedded: not a PNG file (of at most {MAX_FIGURE_BYTES >> 20} MiB)")
+    return data
+
+
+def _read_inputs(evaluate_dir: Path, tune_dir: Path | None, calibration_dir: Path | None) -> dict:
+    """Every input of the report, checked, before anything is written (the documents first)."""
+    return {
+        "evaluation": documents.read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)",
+                                     documents.EVALUATION, "staregen evaluate"),
+        "tuning": documents.read(tune_dir / "result.json", "tuning result (result.json)", documents.TUNING,
+                                 "staregen tune pid") if tune_dir else None,
+        "calibration": documents.read(calibration_dir / "calibration.json", "calibration (calibration.json)",
+                                      documents.CALIBRATION, "staregen calibrate") if calibration_dir else None,
+        "figures": {name: data for name in FIGURES if (data := _read_figure(evaluate_dir / name)) is not None},
+        "calibration_figure": _read_figure(calibration_dir / "fig_ratio_vs_noise.png") if calibration_dir else None,
+    }
 
 
 def write_report(out: Path, evaluate_dir: Path, tune_dir: Path | None, commands: list[str],
                  calibration_dir: Path | None = None) -> dict[str, Path]:
-    evaluation = _read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)")
-    if not isinstance(evaluation, dict) or not {"staring", "step", "frequency"} <= set(evaluation):
-        raise HostError(f"{evaluate_dir / 'evaluate.json'}: not written by `staregen evaluate`")
-    tuning = _read(tune_dir / "result.json", "tuning result (result.json)") if tune_dir else None
+    inputs = _read_inputs(evaluate_dir, tune_dir, calibration_dir)
+    evaluation, tuning, calibration = inputs["evaluation"], inputs["tuning"], inputs["calibration"]
     out.mkdir(parents=True, exist_ok=True)
-    figures = {}
-    for name in ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png"):
-        src = evaluate_dir / name
-        if src.is_file():
-            figures[name] = _copy_figure(src, out / name)
-    calibration, cal_figure = None, None
-    if calibration_dir is not None:
-        calibration = _read_calibration(calibration_dir)
-        if (calibration_dir / "fig_ratio_vs_noise.png").is_file():
-            cal_figure = _copy_figure(calibration_dir / "fig_ratio_vs_noise.png", out / "fig_ratio_vs_noise.png")
+    figures = {name: atomic.write_bytes(out / name, data) for name, data in inputs["figures"].items()}
+    cal_figure = None
+    if inputs["calibration_figure"] is not None:
+        cal_figure = atomic.write_bytes(out / "fig_ratio_vs_noise.png", inputs["calibration_figure"])
     facts = {"date": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
              "machine": f"{platform.machine()} {platform.system()} {platform.release()}, Python {platform.python_version()}",
              "evaluation wall times [s]": json.dumps(evaluation.get("timing", {}))}

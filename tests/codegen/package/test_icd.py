@@ -329,3 +329,13 @@ def test_deterministic_and_package_build_stated():
     # the manifest-shaped self-test evidence renders too
     ev["units"]["controller"]["selftest_vectors"] = {"n": 8, "classes": {"inside": 5, "edges": 3}, "targets": {}}
     assert "Self-test vectors: 8 (inside 5, edges 3)." in render(pkg=pkg, evidence=ev)
+
+
+def test_input_file_names_are_escaped_for_markdown_and_html():
+    """Issue 25 defect 15: a file name is any text but `/`; the inputs table shows it literally."""
+    cfg = make_config()
+    cfg["inputs"]["network"]["file"] = "<img src=x onerror=alert(1)>[a](javascript:x)_*.json"
+    text = render(cfg)
+    (row,) = [ln for ln in text.splitlines() if ln.startswith("| network |")]
+    assert "<img" not in text and not re.search(r"(?<!\\)\]\(javascript:", text)   # no raw tag, no link
+    assert split_row(row)[1] == "&lt;img src=x onerror=alert(1)&gt;\\[a\\](javascript:x)\\_\\*.json"

@@ -4,6 +4,7 @@ one, {file} an existing file, {dir} an existing folder, {x} a (5, 12) float32 .n
 one, {cfg} a valid controller.toml, {deep} an artifact nested 100000 deep."""
 from __future__ import annotations
 
+import json
 import os
 
 import numpy as np
@@ -174,6 +175,31 @@ CASES = [
     (["pipeline", "--out", "."], "is the current folder or holds it"),
     (["tune", "pid", "--grid", "kp=17,ki=0,kd=46", "--targets", "1", "--duration", "11", "--out", "{tmp}"],
      "holds no tuning.json"),
+    # issue 25 (CLI, tuning, report)
+    (["report", "--evaluate", "{ev_lists}", "--out", "{tmp}/r"], "evaluate.json: not written by `staregen evaluate`: "
+                                                                  "staring: must be an object"),
+    (["report", "--evaluate", "{ev_row}", "--out", "{tmp}/r"], "staring['PID (Table 1)'].J_A: missing"),
+    (["report", "--evaluate", "{ev_plan}", "--out", "{tmp}/r"], "plan.duration: must be a number > 0, got 'b'"),
+    (["report", "--evaluate", "{ev_zero}", "--out", "{tmp}/r"], "staring['PID (Table 1)'].J: must be a number > 0"),
+    (["report", "--evaluate", "{ev_good}", "--tune", "{tune_best}", "--out", "{tmp}/r"],
+     "result.json: not written by `staregen tune pid`"),
+    (["report", "--evaluate", "{ev_link}", "--out", "{tmp}/r"], "fig10_scatter.png: not embedded: not a regular file"),
+    (["report", "--command", "staregen evaluate", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"],
+     "staregen report: error: --evaluate"),
+    (["tune", "pid", "--targets", "central", "--out", "{tune_list}"],
+     "tuning.json: the tuning plan is not a JSON object"),
+    (["tune", "pid", "--grid", "kp=1.7e308,ki=0,kd=40", "--targets", "central", "--duration", "12", "--out", "{tmp}/t"],
+     "--grid kp: a value the controller configuration cannot hold"),
+    (["tune", "pid", "--grid", "kp=1_0,ki=0,kd=40", "--duration", "5", "--out", "{tmp}/t"], "grid kp=1_0"),
+    (["tune", "pid", "--targets", "{targets_underscore}", "--duration", "5", "--out", "{tmp}/t"], ":1: unknown target"),
+    (["simulate", "--target", "1_20,3_0", "--t-img", "0", "--out", "{tmp}/o"], "unknown target '1_20,3_0'"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--gate-vectors", "1_00",
+      "--vectors", "0"], "--gate-vectors must be an integer in ASCII digits"),
+    (["verify", "--artifact", "{net}", "--vectors", " \u0664 ", "--steps", "2"],
+     "--vectors must be an integer in ASCII digits"),
+    (["artifact", "random", "--shape", "\u0661\u0662-40-3", "--out", "{tmp}/a.json"], "--shape"),
+    (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "--shape 10000-10000-10000"),
+    (["dp", "build", "--data", "{tmp}/none", "--n-max", "1_000", "--out", "{tmp}/t.json"], "--n-max"),
 ]
 
 
@@ -193,6 +219,32 @@ def _bad_scenarios(folder) -> dict[str, str]:
     return out
 
 
+def _issue25_files(folder) -> dict[str, str]:
+    """Issue 25: report inputs with one defect each, a tuning folder whose plan is `[]`, a target row
+    with underscores in its numbers."""
+    row = {"J_A": 4e-4, "J_w": 8e-5, "J": 6e-4, "targets": 1}
+    mean = {"overshoot_pct": [1, 2, 3], "settling_s": [4, 5, 6], "steady_state_deg": [0, 0, 0]}
+    good = {"staring": {"PID (Table 1)": row}, "step": {"PID (Table 1)": {"mean": mean}},
+            "frequency": {"PID (Table 1)": {"freqs_hz": [1.0], "amplitude_deg": [[1e-3]] * 3}},
+            "plan": {"targets": 1, "duration": 12.0, "response_targets": 1, "freqs_hz": [1.0], "seed": 0}}
+    docs = {"ev_good": good, "ev_lists": {"staring": [], "step": {}, "frequency": {}},
+            "ev_row": {**good, "staring": {"PID (Table 1)": {}}},
+            "ev_plan": {**good, "plan": {**good["plan"], "duration": "b"}},
+            "ev_zero": {**good, "staring": {"PID (Table 1)": {**row, "J": 0}}}, "ev_link": good}
+    out = {}
+    for name, doc in docs.items():
+        (folder / name).mkdir()
+        (folder / name / "evaluate.json").write_text(json.dumps(doc))
+        out[name] = str(folder / name)
+    os.symlink("/etc/passwd", folder / "ev_link" / "fig10_scatter.png")
+    for name, file, text in (("tune_best", "result.json", '{"best": 5}'), ("tune_list", "tuning.json", "[]")):
+        (folder / name).mkdir()
+        (folder / name / file).write_text(text)
+        out[name] = str(folder / name)
+    (folder / "targets_underscore.csv").write_text("a,1_20,3_0\n")
+    return {**out, "targets_underscore": str(folder / "targets_underscore.csv")}
+
+
 @pytest.fixture()
 def places(tmp_path, monkeypatch):
     monkeypatch.chdir(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(__file__)))))
@@ -204,7 +256,7 @@ def places(tmp_path, monkeypatch):
     np.save(tmp_path / "x0.npy", np.zeros((0, 12), np.float32))
     pc.write(default_package_config(), tmp_path / "controller.toml", CONFIG_SOURCES)
     (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
-    return {**_bad_scenarios(tmp_path), "tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
+    return {**_bad_scenarios(tmp_path), **_issue25_files(tmp_path), "tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
             "file": str(tmp_path / "file.txt"), "dir": str(tmp_path / "folder"), "x": str(tmp_path / "x.npy"),
             "x0": str(tmp_path / "x0.npy"), "cfg": str(tmp_path / "controller.toml"), "deep": str(tmp_path / "deep.json")}
 
