@@ -228,8 +228,11 @@ def _dig(doc, *keys) -> dict:
 def check_package(folder: str | Path, run: tuple[str, ...] = ()) -> tuple[dict, list[str], dict]:
     """(manifest, problems, runs): the folder against its manifest and, for each target in `run`,
     the self-test built with the package's CMakeLists (with the ARM reference step's cycles compared
-    to the manifest's). The self-test runs even on an edited folder: it tells whether the edit matters."""
+    to the manifest's). A folder that fails its check is never configured, compiled or run: its
+    CMakeLists.txt is code (execute_process) and an edited file is untrusted."""
     doc, problems = manifest.check(folder)
+    if problems:
+        return doc, problems, {}
     runs = {}
     for target in run:
         try:

@@ -1,7 +1,8 @@
 """`staregen package check DIR [--run x86,arm]`: a flight package against its manifest.
 
-Every file's sha256 is checked; an edited, missing or extra file is named on one line and the
-exit status is 1. With --run the package is built with its own CMakeLists for each target and
+Every file's sha256 is checked; an edited, missing or extra file (or an entry that is not a
+regular file or folder) is named on one line and the exit status is 1. With --run, and only when
+every file checks out (nothing of a failing package is configured, compiled or run), the package is built with its own CMakeLists for each target and
 `<name>_selftest()` runs (x86-64 natively, the STM32F417 image in the Cortex-M4 emulator, whose
 reference step must take the cycles the manifest records).
 """
