@@ -175,8 +175,9 @@ def build_info() -> dict:
 # ----------------------------------------------------------------------------- the package
 
 def build_package(out: str | Path, name: str, units: dict[str, Unit], config: dict, inputs: dict,
-                  plan: EvidencePlan = EvidencePlan(), log=print) -> PackageResult:
-    """Write the flight package of `units` (controller first) into `out`, atomically.
+                  plan: EvidencePlan = EvidencePlan(), log=print, sign_key: bytes | None = None) -> PackageResult:
+    """Write the flight package of `units` (controller first) into `out`, atomically; with
+    `sign_key` the manifest carries its HMAC-SHA256 signature (codegen.package.manifest).
 
     config: the configuration's values (codegen.package.config.PackageConfig.to_mapping());
     inputs: {"config" / "network" / "tanh": {"file": name, "sha256": of the file's bytes, ...}}."""
@@ -205,12 +206,13 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
                 raise ToolError("refusing to write the package: " + "; ".join(failures))
             info = build_info()
             files["ICD.md"] = render_icd(name, units, {**config, "inputs": inputs}, evidence, {
-                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"]})
+                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"],
+                "signed": sign_key is not None})
             atomic.write_text(tmp / "ICD.md", files["ICD.md"])
             body = {"generator": {"name": "staregen", "version": GENERATOR_VERSION}, "name": name,
                     "units": {k: {"entry": u.entry, "identity": u.identity()} for k, u in units.items()},
                     "config": config, "inputs": inputs, "build": info, "evidence": evidence}
-            doc = manifest.document({p: t.encode("utf-8") for p, t in files.items()}, body)
+            doc = manifest.document({p: t.encode("utf-8") for p, t in files.items()}, body, sign_key)
             atomic.write_text(tmp / manifest.MANIFEST, manifest.to_text(doc))
     except OSError as exc:
         raise ToolError(f"cannot write package folder {out}: {exc.strerror or exc}") from None
@@ -225,12 +227,13 @@ def _dig(doc, *keys) -> dict:
     return doc if isinstance(doc, dict) else {}
 
 
-def check_package(folder: str | Path, run: tuple[str, ...] = ()) -> tuple[dict, list[str], dict]:
-    """(manifest, problems, runs): the folder against its manifest and, for each target in `run`,
+def check_package(folder: str | Path, run: tuple[str, ...] = (), key: bytes | None = None) -> tuple[dict, list[str], dict]:
+    """(manifest, problems, runs): the folder against its manifest (and its signature under `key`,
+    when given) and, for each target in `run`,
     the self-test built with the package's CMakeLists (with the ARM reference step's cycles compared
     to the manifest's). A folder that fails its check is never configured, compiled or run: its
     CMakeLists.txt is code (execute_process) and an edited file is untrusted."""
-    doc, problems = manifest.check(folder)
+    doc, problems = manifest.check(folder, key)
     if problems:
         return doc, problems, {}
     runs = {}

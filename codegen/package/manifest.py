@@ -2,12 +2,18 @@
 evidence, sealed by the sha256 of its own canonical text; and the check of a package folder
 against it (edited, missing and extra files, each named on one line).
 
+The seal catches accidents (a truncated copy, a stray edit, a lost file), not tampering: anyone
+who edits a file can recompute its sha256 and the seal. Against tampering the manifest can be
+signed with HMAC-SHA256 under a key file the user keeps (`generate --sign-key FILE`), and the
+signature checked with the same key (`package check --verify-key FILE`).
+
 The manifest holds no date and no path of the generating machine, so generating twice from the
 same inputs gives byte-identical packages.
 """
 from __future__ import annotations
 
 import hashlib
+import hmac
 import json
 import os
 import re
@@ -29,6 +35,10 @@ MAX_MANIFEST_BYTES = 4 << 20
 MAX_FILE_BYTES = 64 << 20
 MAX_ENTRIES = 1_000          # a package holds about a dozen files; a huge tree is refused, not walked
 _CHUNK = 1 << 20
+SIGNATURE = "signature"
+SIGNATURE_ALGORITHM = "HMAC-SHA256"
+KEY_MIN_BYTES = 32           # RFC 2104: a key shorter than the hash's output weakens the MAC
+KEY_MAX_BYTES = 1024
 
 
 class PackageError(CodegenError):
@@ -44,20 +54,56 @@ def _canonical(doc: dict) -> bytes:
 
 
 def seal_of(doc: dict) -> str:
-    """sha256 of the canonical text of everything but the seal itself."""
+    """sha256 of the canonical text of everything but the seal itself (the signature included)."""
     return sha256_bytes(_canonical({k: v for k, v in doc.items() if k != "sha256"}))
 
 
-def document(files: dict[str, bytes], body: dict) -> dict:
+def signature_of(doc: dict, key: bytes) -> str:
+    """HMAC-SHA256 under `key` of the canonical text of everything but the seal and the signature."""
+    body = _canonical({k: v for k, v in doc.items() if k not in ("sha256", SIGNATURE)})
+    return hmac.new(key, body, hashlib.sha256).hexdigest()
+
+
+def document(files: dict[str, bytes], body: dict, key: bytes | None = None) -> dict:
     """The manifest of package `files` ({relative path: bytes}) with `body` (generator, inputs,
-    build, evidence): format, version, body, the files' sha256, and the seal."""
+    build, evidence): format, version, body, the files' sha256, the signature under `key` when
+    one is given, and the seal."""
     for path in files:
         if not PACKAGE_PATH.fullmatch(path):
             raise PackageError(f"package path {path!r} is not one a package may hold")
     doc = {"format": FORMAT, "version": VERSION, **body,
            "files": {p: sha256_bytes(files[p]) for p in sorted(files)}}
+    if key is not None:
+        doc[SIGNATURE] = {"algorithm": SIGNATURE_ALGORITHM, "hmac": signature_of(doc, key)}
     doc["sha256"] = seal_of(doc)
     return doc
+
+
+def signature_problem(doc: dict, key: bytes) -> str | None:
+    """The one-line problem of the manifest's signature under `key`, or None when it verifies."""
+    if SIGNATURE not in doc:
+        return "signature: the manifest is not signed (generate the package with --sign-key)"
+    if not hmac.compare_digest(doc[SIGNATURE]["hmac"], signature_of(doc, key)):
+        return "signature: does not verify with this key (a file was edited and re-sealed, or another key signed it)"
+    return None
+
+
+def load_key(path: str | Path) -> bytes:
+    """The bytes of a signing key file: a regular file of KEY_MIN_BYTES to KEY_MAX_BYTES (read no
+    further), e.g. `head -c 32 /dev/urandom > FILE`. PackageError (one line) otherwise."""
+    path = Path(path)
+    try:
+        key = read_regular(path.resolve(), KEY_MAX_BYTES)
+    except NotRegular:
+        raise PackageError(f"{path}: not a regular file (a key file holds {KEY_MIN_BYTES}-{KEY_MAX_BYTES} bytes)") from None
+    except OSError as exc:
+        raise PackageError(f"{path}: cannot read the key ({exc.strerror or exc})") from None
+    if key is None:
+        raise PackageError(f"{path}: larger than {KEY_MAX_BYTES} bytes (not a key file?)")
+    if len(key) < KEY_MIN_BYTES:
+        raise PackageError(f"{path}: a key needs at least {KEY_MIN_BYTES} bytes, this one has {len(key)} "
+                           f"(e.g. head -c 32 /dev/urandom > FILE)")
+    return key
 
 
 def to_text(doc: dict) -> str:
@@ -97,9 +143,18 @@ def load(folder: str | Path) -> dict:
             raise PackageError(f"{path}: files: {str(rel)[:60]!r} is not a path a package may hold")
         if not isinstance(digest, str) or not re.fullmatch(r"[0-9a-f]{64}", digest):
             raise PackageError(f"{path}: files[{rel}]: not a sha256")
+    if SIGNATURE in doc:
+        _check_signature_field(path, doc[SIGNATURE])
     if doc.get("sha256") != seal_of(doc):
         raise PackageError(f"{path}: sha256: the manifest was edited after it was sealed")
     return doc
+
+
+def _check_signature_field(path: Path, sig) -> None:
+    if not isinstance(sig, dict) or set(sig) != {"algorithm", "hmac"} or sig["algorithm"] != SIGNATURE_ALGORITHM:
+        raise PackageError(f"{path}: {SIGNATURE}: expected {{\"algorithm\": \"{SIGNATURE_ALGORITHM}\", \"hmac\": ...}}")
+    if not isinstance(sig["hmac"], str) or not re.fullmatch(r"[0-9a-f]{64}", sig["hmac"]):
+        raise PackageError(f"{path}: {SIGNATURE}.hmac: not 64 hex digits")
 
 
 class NotRegular(OSError):
@@ -190,10 +245,11 @@ def _file_problem(folder: Path, rel: str, digest: str) -> str | None:
     return None if got == digest else f"edited file: {rel} (sha256 differs from the manifest)"
 
 
-def check(folder: str | Path) -> tuple[dict, list[str]]:
+def check(folder: str | Path, key: bytes | None = None) -> tuple[dict, list[str]]:
     """(manifest, problems): one line per edited, missing or extra file and per entry that is
-    neither a regular file nor a folder (refused unopened); [] when the folder is exactly what
-    the manifest says."""
+    neither a regular file nor a folder (refused unopened), and with `key` one for a manifest
+    that is unsigned or whose signature does not verify; [] when the folder is exactly what the
+    manifest says."""
     folder = Path(folder)
     if not folder.is_dir():
         raise PackageError(f"{folder}: not a directory")
@@ -211,4 +267,5 @@ def check(folder: str | Path) -> tuple[dict, list[str]]:
         if problem:
             problems.append(problem)
     problems += [f"extra file: {rel}" for rel in sorted(present - set(listed))]
-    return doc, problems
+    signature = signature_problem(doc, key) if key is not None else None
+    return doc, ([signature] if signature else []) + problems

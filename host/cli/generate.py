@@ -13,6 +13,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen.package import config as pc
+from codegen.package.manifest import load_key
 from codegen.package.selftest import MAX_VECTORS
 from codegen.units.tanh.emit import params_sha256
 from codegen.units.tanh.params import load_params
@@ -32,6 +33,8 @@ def register(subparsers) -> None:
     p.add_argument("--tanh", default=None, metavar="FILE", help="tanh-law parameter file (when the configuration "
                    "includes the tanh unit)")
     p.add_argument("--out", required=True, metavar="DIR", help="package folder (replaced if it holds a package)")
+    p.add_argument("--sign-key", default=None, metavar="FILE", help="key file (at least 32 random bytes, kept by "
+                   "you): sign the manifest with HMAC-SHA256 (`package check --verify-key FILE`)")
     add_evidence_arguments(p)
     p.set_defaults(func=run)
 
@@ -63,11 +66,11 @@ def file_sha256(path: Path) -> str:
 
 
 def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,
-             plan: EvidencePlan = EvidencePlan(), log=print):
+             plan: EvidencePlan = EvidencePlan(), log=print, sign_key: bytes | None = None):
     """The package of a validated configuration and network (also the pipeline's last stage)."""
     check_output_folder(out, marker="manifest.json")
     units = package_units(cfg, network, tanh)
-    return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log)
+    return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log, sign_key)
 
 
 def summary(result) -> list[str]:
@@ -83,6 +86,7 @@ def summary(result) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     plan = evidence_plan(args)
+    sign_key = load_key(args.sign_key) if args.sign_key is not None else None
     cfg = pc.load(args.config)
     network = art.load(args.network)
     tanh = load_params(args.tanh) if args.tanh is not None else None
@@ -94,6 +98,6 @@ def run(args: argparse.Namespace) -> int:
         tanh_path = Path(args.tanh)
         inputs["tanh"] = {"file": tanh_path.name, "sha256": file_sha256(tanh_path),
                           "values_sha256": params_sha256(tanh, cfg.controller.control_period)}
-    result = generate(cfg, network, Path(args.out), inputs, tanh, plan)
+    result = generate(cfg, network, Path(args.out), inputs, tanh, plan, sign_key=sign_key)
     print("\n".join(summary(result)))
     return 0

@@ -165,6 +165,19 @@ CASES = [
     (["calibrate", "--network", "{net}", "--scales", "-1", "--out", "{tmp}/c"], "--scales"),
     (["calibrate", "--network", "{net}", "--targets", "3", "--response-targets", "5", "--out", "{tmp}/c"],
      "--response-targets"),
+    # issue 25 (integrity)
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{file}"],
+     "a key needs at least 32 bytes"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{net}"],
+     "larger than 1024 bytes"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{dir}"],
+     "not a regular file"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{tmp}/none.key"],
+     "cannot read the key"),
+    (["package", "check", "{dir}", "--verify-key", "/dev/zero"], "not a regular file"),
+    (["package", "check", "{dir}", "--verify-key", "{file}"], "a key needs at least 32 bytes"),
+    (["package", "check", "{dir}", "--verify-key", "{tmp}/none.key"], "cannot read the key"),
+    (["package", "check", "{dir}", "--run", "x86,qemu2"], "unknown target 'qemu2'"),
 ]
 
 
