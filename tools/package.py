@@ -35,11 +35,13 @@ from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES
 from tools.errors import ToolError
 from tools.gate import count_mismatches, run_gate
 from tools.m4.profile import MODES
-from tools.package_run import run_arm, run_x86
+from tools.package_run import run_arm, run_qemu, run_x86
 from tools.report import cycle_report
 from tools.runners import runner
 
 TARGETS = ("x86", "arm")
+# `package check --run` also takes qemu: the ARM image in QEMU's netduinoplus2, a second emulator
+RUN_TARGETS = ("x86", "arm", "qemu")
 
 
 @dataclass(frozen=True)
@@ -154,9 +156,14 @@ def run_package(folder: Path, name: str, targets=TARGETS, c_flags=()) -> dict:
             image = build_image(folder, name, target, Path(tmp) / target, c_flags=c_flags)
             if target == "x86":
                 out["x86"] = {"selftest_mismatches": run_x86(image)}
+            elif target == "qemu":
+                run = run_qemu(image)
+                out["qemu"] = {"selftest_mismatches": run.mismatches, "reference_output": list(run.output),
+                               "seconds": run.seconds}
             else:
                 run = run_arm(image, name)
-                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles)}
+                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles),
+                              "reference_output": list(run.output)}
     return out
 
 
@@ -227,6 +234,19 @@ def _dig(doc, *keys) -> dict:
     return doc if isinstance(doc, dict) else {}
 
 
+def _qemu_problems(doc: dict, runs: dict) -> list[str]:
+    """The reference step's output words in QEMU against the Unicorn run's (this check's, else the
+    manifest's, recorded from the Unicorn run at generation)."""
+    want = runs["arm"]["reference_output"] if "arm" in runs else \
+        _dig(doc, "evidence", "package_build", "arm").get("reference_output")
+    got = runs["qemu"]["reference_output"]
+    if not want:
+        return ["qemu: no Unicorn reference output to compare with (add arm to --run)"]
+    if got != want:
+        return [f"qemu: reference step output words {' '.join(got)} differ from the Unicorn run's {' '.join(want)}"]
+    return []
+
+
 def check_package(folder: str | Path, run: tuple[str, ...] = (), key: bytes | None = None) -> tuple[dict, list[str], dict]:
     """(manifest, problems, runs): the folder against its manifest (and its signature under `key`,
     when given) and, for each target in `run`,
@@ -247,6 +267,8 @@ def check_package(folder: str | Path, run: tuple[str, ...] = (), key: bytes | No
         got = runs["arm"]["reference_cycles"]
         if want and got != want:
             problems.append(f"arm: reference step takes {got} cycles, the manifest says {want}")
+    if "qemu" in runs:
+        problems += _qemu_problems(doc, runs)
     problems += [f"{t}: self-test reports {r['selftest_mismatches']} mismatching words"
                  for t, r in runs.items() if r["selftest_mismatches"] != 0]
     return doc, problems, runs

@@ -1,6 +1,7 @@
 """Issue 25, integrity of a delivered package: nothing of a package that fails its check is built
 or run (defect 5); entries that are not regular files or folders are refused unopened, and no file
-is read beyond a cap whatever its size (defect 7)."""
+is read beyond a cap whatever its size (defect 7); the package's ARM image also runs in QEMU's
+netduinoplus2, a second emulator, with the reference step's output words equal to Unicorn's."""
 from __future__ import annotations
 
 import os
@@ -8,15 +9,20 @@ import resource
 import shutil
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
 
 from codegen.artifact import random_artifact
 from codegen.package import manifest
+from firmware.package_build import build_image
 from host.cli import main
 from host.control.nn_controller import default_package_config
 from host.sim.scenarios import package_units
+from tests.tools.test_package import flip_weight_bit
+from tools import package_run
+from tools.errors import ToolError
 from tools.package import EvidencePlan, build_package, check_package
 
 REPO = Path(__file__).resolve().parents[2]
@@ -117,3 +123,33 @@ def test_a_file_that_grows_past_its_size_is_capped(tmp_path):
     assert manifest.read_regular(path, 100) == b"x" * 100
     assert manifest.read_regular(path, 99) is None
     assert manifest.file_sha256(path, 99) is None
+
+
+# ----------------------------------------------------------------------------- QEMU
+
+def test_package_runs_in_qemu_as_in_the_cortex_m4_emulator(package, capsys):
+    doc, problems, runs = check_package(package.folder, ("x86", "arm", "qemu"))
+    assert problems == [] and {t: r["selftest_mismatches"] for t, r in runs.items()} == {"x86": 0, "arm": 0, "qemu": 0}
+    words = runs["qemu"]["reference_output"]
+    assert len(words) >= 4 and words == runs["arm"]["reference_output"]      # bit for bit, as hex words
+    assert words == doc["evidence"]["package_build"]["arm"]["reference_output"]
+    assert runs["qemu"]["seconds"] < package_run.QEMU_TIMEOUT_S
+    code = main(["package", "check", str(package.folder), "--run", "qemu"])   # against the manifest's words
+    out = capsys.readouterr().out
+    assert code == 0 and f"qemu: self-test 0 mismatching words; reference step output {' '.join(words)}" in out
+
+
+def test_qemu_catches_a_flipped_weight_bit(package, tmp_path):
+    folder = tmp_path / "copy"
+    shutil.copytree(package.folder, folder)
+    flip_weight_bit(folder)
+    run = package_run.run_qemu(build_image(folder, "stare", "qemu", tmp_path / "qemu"))
+    assert run.mismatches > 0
+
+
+def test_a_hung_qemu_is_killed_at_its_time_out(package, monkeypatch):
+    monkeypatch.setattr(package_run, "qemu_command", lambda elf: ["sleep", "60"])
+    t0 = time.perf_counter()
+    with pytest.raises(ToolError, match=r"did not finish within 0.5 s \(killed\)"):
+        package_run.run_qemu(package.folder / "ICD.md", timeout=0.5)
+    assert time.perf_counter() - t0 < 10
