@@ -1,7 +1,10 @@
 """Issue 25, integrity of a delivered package: nothing of a package that fails its check is built
 or run (defect 5); entries that are not regular files or folders are refused unopened, and no file
-is read beyond a cap whatever its size (defect 7); the package's ARM image also runs in QEMU's
-netduinoplus2, a second emulator, with the reference step's output words equal to Unicorn's."""
+is read beyond a cap whatever its size (defect 7); every FP-environment bit the ICD names is
+caught by the self-test on the STM32F417 image, or proven not to change any output (FPSCR.DN,
+defect 20; the x86 MXCSR bits: tests/codegen/package/test_selftest.py); the package's ARM image
+also runs in QEMU's netduinoplus2, a second emulator, with the reference step's output words equal
+to Unicorn's."""
 from __future__ import annotations
 
 import os
@@ -12,30 +15,41 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
+from unicorn import arm_const as R
 
 from codegen.artifact import random_artifact
+from codegen.unit import Batch
 from codegen.package import manifest
 from firmware.package_build import build_image
 from host.cli import main
 from host.control.nn_controller import default_package_config
-from host.sim.scenarios import package_units
+from host.sim import tanh_example
+from host.sim.scenarios import configure_unit, package_units
 from tests.tools.test_package import flip_weight_bit
 from tools import package_run
 from tools.errors import ToolError
+from tools.gate import count_mismatches
+from tools.m4.elf import Image
+from tools.m4.harness import Harness
+from tools.m4.machine import Machine
 from tools.package import EvidencePlan, build_package, check_package
+from tools.runners import arm_build, pack, unpack
 
 REPO = Path(__file__).resolve().parents[2]
 PLAN = EvidencePlan(gate_vectors=200, gate_sequences=1, sequence_steps=20, selftest_vectors=8, cycles_per_class=1)
 CLI = "import sys; from host.cli import main; sys.exit(main())"
+FZ, DN = 1 << 24, 1 << 25
+RMODE = {"plus-inf": 1 << 22, "minus-inf": 2 << 22, "zero": 3 << 22}
+ARTIFACT = random_artifact((12, 40, 3), seed=1)
 
 
 @pytest.fixture(scope="module")
 def package(tmp_path_factory):
     cfg = default_package_config()
-    artifact = random_artifact((12, 40, 3), seed=1)
-    return build_package(tmp_path_factory.mktemp("pkg") / "stare", cfg.name, package_units(cfg, artifact),
-                         cfg.to_mapping(), {"network": {"sha256": artifact.sha256}}, PLAN, log=lambda _line: None)
+    return build_package(tmp_path_factory.mktemp("pkg") / "stare", cfg.name, package_units(cfg, ARTIFACT),
+                         cfg.to_mapping(), {"network": {"sha256": ARTIFACT.sha256}}, PLAN, log=lambda _line: None)
 
 
 @pytest.fixture()
@@ -153,3 +167,79 @@ def test_a_hung_qemu_is_killed_at_its_time_out(package, monkeypatch):
     with pytest.raises(ToolError, match=r"did not finish within 0.5 s \(killed\)"):
         package_run.run_qemu(package.folder / "ICD.md", timeout=0.5)
     assert time.perf_counter() - t0 < 10
+
+
+# ----------------------------------------------------------------------------- defect 20 (ARM)
+
+def selftest_under(elf: Path, fpscr: int) -> tuple[int, int]:
+    """(mismatches, environment bits) of `stare_selftest()` in the image with FPSCR set after start-up."""
+    machine = Machine(Image(elf))
+    machine.boot()
+    machine.set_fpscr(fpscr)
+    return (machine.call("stare_selftest", max_insns=200_000_000),
+            machine.call("stare_selftest_fp_environment", max_insns=10_000))
+
+
+@pytest.fixture(scope="module")
+def arm_image(package, tmp_path_factory) -> Path:
+    return build_image(package.folder, "stare", "arm", tmp_path_factory.mktemp("arm"))
+
+
+@pytest.mark.parametrize("fpscr, env", [(0, 0), (FZ, 1 | 16), (RMODE["plus-inf"], 4), (RMODE["minus-inf"], 2),
+                                        (RMODE["zero"], 2 | 4), (FZ | DN, 1 | 16)],
+                         ids=["ieee", "FZ", "RP", "RM", "RZ", "FZ+DN"])
+def test_arm_selftest_catches_flush_to_zero_and_every_rounding_mode(arm_image, fpscr, env):
+    mismatches, got = selftest_under(arm_image, fpscr)
+    assert got == env
+    assert (mismatches == 0) == (env == 0) and mismatches >= bin(env).count("1")
+
+
+def _random_bits(unit, n: int, seed: int) -> Batch:
+    """Records of random bits: NaNs of every payload and sign, subnormals, infinities."""
+    words = np.random.default_rng(seed).integers(0, 2**32, (n, unit.input_dtype.itemsize // 4), dtype=np.uint32)
+    return Batch(unit.init_state(n) if unit.stateful else None, words.view(unit.input_dtype).reshape(-1))
+
+
+def _arm_records(unit, batch: Batch, fpscr: int):
+    harness = Harness(arm_build(unit, "records").elf, max_insns_per_record=unit.max_instructions)
+    harness.machine.set_fpscr(fpscr)
+    rec = pack(unit, batch)
+    return unpack(unit, harness.run(rec.view(np.uint8).reshape(rec.shape[0], -1)))
+
+
+def test_default_nan_mode_is_in_effect_in_the_emulator(arm_image):
+    """What makes the test below mean something: after set_fpscr(DN) a NaN operand's payload and
+    sign are replaced by the default NaN's (vadd.f32 s0, s0, s1; bx lr on -NaN(0x000001) + 1)."""
+    machine = Machine(Image(arm_image))
+    machine.boot()
+    code = 0x0F000200                                   # the emulator's reserved return page, unused here
+    machine.write(code, bytes.fromhex("30ee200a7047"))
+    results = []
+    for fpscr in (0, DN):
+        machine.set_fpscr(fpscr)
+        machine.uc.reg_write(R.UC_ARM_REG_S0, 0xFFC00001)
+        machine.uc.reg_write(R.UC_ARM_REG_S1, 0x3F800000)
+        machine.call(code, max_insns=10)
+        results.append(machine.uc.reg_read(R.UC_ARM_REG_S0))
+    assert results == [0xFFC00001, 0x7FC00000]
+
+
+@pytest.mark.parametrize("kind", ["controller", "tanh"])
+def test_default_nan_mode_changes_no_output_word(kind, arm_image):
+    """FPSCR.DN only replaces a NaN result's payload and sign by the default NaN's; every NaN the
+    units let out is canonical, so over every gate class and random bits (NaN payloads included)
+    no output or state word changes, and the ICD allows DN = 0 or 1. The self-test agrees."""
+    inputs = {"artifact": ARTIFACT} if kind == "controller" else {"params": tanh_example.paper_parameters()}
+    unit = configure_unit(kind, **inputs)
+    classes = [b for b in unit.gate_classes(4_000, 0).values() if b.input.shape[0] > 0]
+    gate = Batch(np.concatenate([b.state for b in classes]) if unit.stateful else None,
+                 np.concatenate([b.input for b in classes]))
+    for batch in (gate, _random_bits(unit, 4_000, 1)):
+        out0, state0 = _arm_records(unit, batch, 0)
+        out1, state1 = _arm_records(unit, batch, DN)
+        golden, golden_state = unit.golden(None if batch.state is None else batch.state.copy(), batch.input)
+        assert count_mismatches(golden, out0) == 0            # DN = 0 is the golden model
+        assert count_mismatches(out0, out1) == 0              # ... and so is DN = 1, word for word
+        if unit.stateful:
+            assert count_mismatches(golden_state, state0) == 0 and count_mismatches(state0, state1) == 0
+    assert selftest_under(arm_image, DN) == (0, 0)
