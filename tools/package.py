@@ -249,19 +249,22 @@ def _qemu_problems(doc: dict, runs: dict) -> list[str]:
 
 def check_package(folder: str | Path, run: tuple[str, ...] = (), key: bytes | None = None) -> tuple[dict, list[str], dict]:
     """(manifest, problems, runs): the folder against its manifest (and its signature under `key`,
-    when given) and, for each target in `run`,
-    the self-test built with the package's CMakeLists (with the ARM reference step's cycles compared
-    to the manifest's). A folder that fails its check is never configured, compiled or run: its
-    CMakeLists.txt is code (execute_process) and an edited file is untrusted."""
+    when given) and, for each target in `run`, the self-test built with the package's CMakeLists
+    (the ARM reference step's cycles compared to the manifest's, QEMU's output words to Unicorn's).
+    A folder that fails its check is never configured, compiled or run: its CMakeLists.txt is code
+    (execute_process) and an edited file is untrusted. What is built is a private copy of the
+    bytes that were checked."""
     doc, problems = manifest.check(folder, key)
-    if problems:
+    if problems or not run:
         return doc, problems, {}
     runs = {}
-    for target in run:
-        try:
-            runs.update(run_package(Path(folder), doc["name"], (target,)))
-        except (FirmwareError, ToolError) as exc:
-            problems.append(f"{target}: the package does not build or run: {exc}")
+    with tempfile.TemporaryDirectory(prefix="staregen-check-") as tmp:
+        problems = manifest.copy_verified(folder, doc, tmp)    # build the bytes checked, not the folder
+        for target in run if not problems else ():
+            try:
+                runs.update(run_package(Path(tmp), doc["name"], (target,)))
+            except (FirmwareError, ToolError) as exc:
+                problems.append(f"{target}: the package does not build or run: {exc}")
     if "arm" in runs:
         want = _dig(doc, "evidence", "package_build", "arm", "reference_cycles")
         got = runs["arm"]["reference_cycles"]

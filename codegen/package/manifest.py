@@ -269,3 +269,23 @@ def check(folder: str | Path, key: bytes | None = None) -> tuple[dict, list[str]
     problems += [f"extra file: {rel}" for rel in sorted(present - set(listed))]
     signature = signature_problem(doc, key) if key is not None else None
     return doc, ([signature] if signature else []) + problems
+
+
+def copy_verified(folder: str | Path, doc: dict, dst: str | Path) -> list[str]:
+    """Copy every file the manifest lists from `folder` into `dst`, each from bytes read once and
+    hashed again: what is built afterwards is exactly what was checked, even if the folder changes
+    after `check` (a file swapped in between is a problem line, not a build input)."""
+    folder, dst = Path(folder), Path(dst)
+    problems = []
+    for rel, digest in sorted(doc["files"].items()):
+        try:
+            data = read_regular(folder / rel, MAX_FILE_BYTES)
+        except OSError as exc:
+            problems.append(f"changed during the check: {rel} ({exc.strerror or exc})")
+            continue
+        if data is None or sha256_bytes(data) != digest:
+            problems.append(f"changed during the check: {rel} (sha256 differs from the manifest)")
+            continue
+        (dst / rel).parent.mkdir(parents=True, exist_ok=True)
+        (dst / rel).write_bytes(data)
+    return problems

@@ -85,6 +85,17 @@ def test_edited_cmakelists_is_neither_configured_nor_run(folder, tmp_path, capsy
     assert not marker.exists()
 
 
+def test_only_the_bytes_checked_are_copied_for_the_build(folder, tmp_path):
+    doc, problems = manifest.check(folder)
+    assert problems == []
+    cmake = folder / "CMakeLists.txt"
+    cmake.write_text(cmake.read_text() + "execute_process(COMMAND true)\n")   # swapped after the check
+    problems = manifest.copy_verified(folder, doc, tmp_path / "build")
+    assert problems == ["changed during the check: CMakeLists.txt (sha256 differs from the manifest)"]
+    assert not (tmp_path / "build" / "CMakeLists.txt").exists()
+    assert (tmp_path / "build" / "src" / "stare.c").read_bytes() == (folder / "src" / "stare.c").read_bytes()
+
+
 def test_an_intact_package_still_runs(package):
     _, problems, runs = check_package(package.folder, ("x86",))
     assert problems == [] and runs["x86"]["selftest_mismatches"] == 0
