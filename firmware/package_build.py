@@ -68,7 +68,8 @@ def qemu_linker_script(build_dir: Path) -> Path:
 def build_image(package_dir: str | Path, name: str, target: str, build_dir: str | Path,
                 c_flags: Sequence[str] = ()) -> Path:
     """Configure and build the image of `package_dir` for `target`; returns the ELF (arm, qemu) or
-    the executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
+    the executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a
+    fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
     if not _NAME.fullmatch(name):
@@ -81,8 +82,9 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
         raise FirmwareError(f"package build: {package_dir} has no CMakeLists.txt")
     build_dir.mkdir(parents=True, exist_ok=True)
     cmake = _cmake()
+    cmake_target = "x86" if target == "x86" else "arm"      # the QEMU image is an ARM image
     cmd = [cmake, "-S", str(IMAGE_PROJECT), "-B", str(build_dir), f"-DSG_PACKAGE_DIR={package_dir}",
-           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={'x86' if target == 'x86' else 'arm'}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
+           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={cmake_target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
     if target in ("arm", "qemu"):
         if shutil.which("arm-none-eabi-gcc") is None:
             raise FirmwareError("package build: 'arm-none-eabi-gcc' not found on PATH (see tools/setup.sh)")

@@ -234,11 +234,17 @@ def _dig(doc, *keys) -> dict:
     return doc if isinstance(doc, dict) else {}
 
 
+def _recorded_words(doc: dict) -> list[str] | None:
+    """The reference step's output words the manifest recorded from the Unicorn run, if well-formed."""
+    words = _dig(doc, "evidence", "package_build", "arm").get("reference_output")
+    ok = isinstance(words, list) and all(isinstance(w, str) and len(w) == 8 for w in words)
+    return words if ok else None
+
+
 def _qemu_problems(doc: dict, runs: dict) -> list[str]:
     """The reference step's output words in QEMU against the Unicorn run's (this check's, else the
     manifest's, recorded from the Unicorn run at generation)."""
-    want = runs["arm"]["reference_output"] if "arm" in runs else \
-        _dig(doc, "evidence", "package_build", "arm").get("reference_output")
+    want = runs["arm"]["reference_output"] if "arm" in runs else _recorded_words(doc)
     got = runs["qemu"]["reference_output"]
     if not want:
         return ["qemu: no Unicorn reference output to compare with (add arm to --run)"]
@@ -247,7 +253,8 @@ def _qemu_problems(doc: dict, runs: dict) -> list[str]:
     return []
 
 
-def check_package(folder: str | Path, run: tuple[str, ...] = (), key: bytes | None = None) -> tuple[dict, list[str], dict]:
+def check_package(folder: str | Path, run: tuple[str, ...] = (),
+                  key: bytes | None = None) -> tuple[dict, list[str], dict]:
     """(manifest, problems, runs): the folder against its manifest (and its signature under `key`,
     when given) and, for each target in `run`, the self-test built with the package's CMakeLists
     (the ARM reference step's cycles compared to the manifest's, QEMU's output words to Unicorn's).

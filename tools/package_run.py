@@ -88,7 +88,10 @@ def qemu_command(elf: str | Path) -> list[str]:
     exe = shutil.which("qemu-system-arm")
     if exe is None:
         raise ToolError("qemu-system-arm not found on PATH (Debian's qemu-system-arm; see tools/setup.sh)")
+    # semihosting lets the image ask the host for a shell command (SYS_SYSTEM): the seccomp sandbox
+    # denies QEMU any new process, whatever the image asks
     return [exe, "-M", QEMU_MACHINE, "-nodefaults", "-display", "none", "-monitor", "none", "-serial", "null",
+            "-sandbox", "on,obsolete=deny,elevateprivileges=deny,spawn=deny,resourcecontrol=deny",
             "-semihosting-config", "enable=on,target=native", "-kernel", str(elf)]
 
 
@@ -99,7 +102,7 @@ def run_qemu(elf: str | Path, timeout: float = QEMU_TIMEOUT_S) -> QemuRun:
     t0 = time.perf_counter()
     try:
         res = subprocess.run(qemu_command(elf), capture_output=True, text=True, timeout=timeout,
-                             stdin=subprocess.DEVNULL, check=False)
+                             stdin=subprocess.DEVNULL, cwd=Path(elf).parent, check=False)
     except subprocess.TimeoutExpired:
         raise ToolError(f"qemu: {Path(elf).name} did not finish within {timeout:g} s (killed)") from None
     except OSError as exc:

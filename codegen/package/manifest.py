@@ -95,7 +95,8 @@ def load_key(path: str | Path) -> bytes:
     try:
         key = read_regular(path.resolve(), KEY_MAX_BYTES)
     except NotRegular:
-        raise PackageError(f"{path}: not a regular file (a key file holds {KEY_MIN_BYTES}-{KEY_MAX_BYTES} bytes)") from None
+        raise PackageError(f"{path}: not a regular file (a key file holds "
+                           f"{KEY_MIN_BYTES}-{KEY_MAX_BYTES} bytes)") from None
     except OSError as exc:
         raise PackageError(f"{path}: cannot read the key ({exc.strerror or exc})") from None
     if key is None:

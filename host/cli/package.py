@@ -3,9 +3,10 @@
 Every file's sha256 is checked; an edited, missing or extra file (or an entry that is not a
 regular file or folder) is named on one line and the exit status is 1. With --run, and only when
 every file checks out (nothing of a failing package is configured, compiled or run), the package
-is built with its own CMakeLists for each target and `<name>_selftest()` runs (x86-64 natively, the STM32F417 image in the Cortex-M4 emulator, whose
-reference step must take the cycles the manifest records, and in QEMU's netduinoplus2, whose
-reference step must give the same output words as the Cortex-M4 emulator's).
+is built with its own CMakeLists for each target and `<name>_selftest()` runs: x86-64 natively,
+the STM32F417 image in the Cortex-M4 emulator (whose reference step must take the cycles the
+manifest records) and in QEMU's netduinoplus2 (whose reference step must give the same output
+words as the Cortex-M4 emulator's).
 
 The manifest's seal catches accidents, not tampering (anyone can recompute it). With
 --verify-key FILE the manifest's HMAC-SHA256 signature (`generate --sign-key FILE`) must verify
