@@ -77,15 +77,6 @@ def test_signed_package_verifies_and_a_resealed_edit_does_not(tmp_path, capsys, 
     assert code == 1 and out == f"{pkg}: signature: the manifest is not signed (generate the package with --sign-key)\n"
 
 
-def test_unsigned_package_says_so_in_its_icd(tmp_path, capsys, inputs):
-    cfg, net = inputs
-    pkg = tmp_path / "pkg"
-    assert cli(capsys, "generate", "--config", cfg, "--network", net, "--out", pkg, *SMALL)[0] == 0
-    icd = (pkg / "ICD.md").read_text()
-    assert "catches accidents" in icd and "not tampering" in icd and "This manifest is not signed" in icd
-    assert "signature" not in json.loads((pkg / "manifest.json").read_text())
-
-
 def test_key_files_are_validated(tmp_path):
     (tmp_path / "short").write_bytes(b"x" * 31)
     (tmp_path / "long").write_bytes(b"x" * (manifest.KEY_MAX_BYTES + 1))
