@@ -1,6 +1,8 @@
 """A flight package built the way a firmware team builds it: with its own CMakeLists.txt, added
 by firmware/package_image (a main that runs `<name>_selftest()` and one reference step), for the
-STM32F417 (arm-none-eabi-gcc, firmware/startup.c and stm32f417.ld) or for x86-64 (host gcc).
+STM32F417 (arm-none-eabi-gcc, firmware/startup.c and stm32f417.ld), for QEMU's netduinoplus2
+(the same, reporting by semihosting, with CCM moved into SRAM: see `qemu_linker_script`) or for
+x86-64 (host gcc).
 
 No cache: this is the end-to-end check of the package as delivered, run at generation, by
 `staregen package check --run` and by the tests.
@@ -19,7 +21,13 @@ from firmware.errors import FirmwareError
 HERE = Path(__file__).resolve().parent
 IMAGE_PROJECT = HERE / "package_image"
 TOOLCHAIN = IMAGE_PROJECT / "toolchain-arm-none-eabi.cmake"
-TARGETS = ("arm", "x86")
+LINKER_SCRIPT = HERE / "stm32f417.ld"
+TARGETS = ("arm", "qemu", "x86")
+# QEMU 7.2's netduinoplus2 (STM32F405) maps no CCM at 0x10000000 (`info mtree`: flash, 192 KB of SRAM
+# at 0x20000000, peripherals): its image keeps the constant tables in the top 64 KB of that SRAM,
+# above the 128 KB the STM32F417 map uses, so the copy to RAM and its CRC run as on the board.
+CCM_REGION = "CCM   (rw)  : ORIGIN = 0x10000000, LENGTH = 64K"
+QEMU_CCM_REGION = "CCM   (rw)  : ORIGIN = 0x20020000, LENGTH = 64K"
 _NAME = re.compile(r"[a-z][a-z0-9_]{0,30}")
 _FLAG = re.compile(r"-[A-Za-z0-9_=+.,-]+")
 
@@ -47,10 +55,21 @@ def _run(cmd: list[str], what: str) -> None:
         raise FirmwareError(f"package build ({what}): {_first_error(res.stdout + res.stderr)}")
 
 
+def qemu_linker_script(build_dir: Path) -> Path:
+    """stm32f417.ld with CCM moved to QEMU's SRAM (above), written into `build_dir`."""
+    text = LINKER_SCRIPT.read_text()
+    if text.count(CCM_REGION) != 1:
+        raise FirmwareError(f"package build: {LINKER_SCRIPT.name} has no single line {CCM_REGION!r}")
+    path = build_dir / "stm32f405_qemu.ld"
+    path.write_text(text.replace(CCM_REGION, QEMU_CCM_REGION))
+    return path
+
+
 def build_image(package_dir: str | Path, name: str, target: str, build_dir: str | Path,
                 c_flags: Sequence[str] = ()) -> Path:
-    """Configure and build the image of `package_dir` for `target`; returns the ELF (arm) or the
-    executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
+    """Configure and build the image of `package_dir` for `target`; returns the ELF (arm, qemu) or
+    the executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a
+    fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
     if not _NAME.fullmatch(name):
@@ -63,17 +82,20 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
         raise FirmwareError(f"package build: {package_dir} has no CMakeLists.txt")
     build_dir.mkdir(parents=True, exist_ok=True)
     cmake = _cmake()
+    cmake_target = "x86" if target == "x86" else "arm"      # the QEMU image is an ARM image
     cmd = [cmake, "-S", str(IMAGE_PROJECT), "-B", str(build_dir), f"-DSG_PACKAGE_DIR={package_dir}",
-           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
-    if target == "arm":
+           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={cmake_target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
+    if target in ("arm", "qemu"):
         if shutil.which("arm-none-eabi-gcc") is None:
             raise FirmwareError("package build: 'arm-none-eabi-gcc' not found on PATH (see tools/setup.sh)")
         cmd.append(f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAIN}")
-    else:
+    if target == "qemu":
+        cmd += ["-DSG_SEMIHOSTING=ON", f"-DSG_LINKER_SCRIPT={qemu_linker_script(build_dir)}"]
+    elif target == "x86":
         cmd.append("-DCMAKE_C_COMPILER=gcc")
     _run(cmd, "configure")
     _run([cmake, "--build", str(build_dir), "--", "-j2"], "compile")
-    image = build_dir / ("image.elf" if target == "arm" else "image")
+    image = build_dir / ("image" if target == "x86" else "image.elf")
     if not image.is_file():
         raise FirmwareError(f"package build: {image.name} was not produced")
     return image

@@ -36,11 +36,13 @@ from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES
 from tools.errors import ToolError
 from tools.gate import count_mismatches, run_gate
 from tools.m4.profile import MODES
-from tools.package_run import run_arm, run_x86
+from tools.package_run import run_arm, run_qemu, run_x86
 from tools.report import cycle_report
 from tools.runners import runner
 
 TARGETS = ("x86", "arm")
+# `package check --run` also takes qemu: the ARM image in QEMU's netduinoplus2, a second emulator
+RUN_TARGETS = ("x86", "arm", "qemu")
 
 
 @dataclass(frozen=True)
@@ -157,9 +159,14 @@ def run_package(folder: Path, name: str, targets=TARGETS, c_flags=(), work: Path
             image = build_image(folder, name, target, Path(tmp) / target, c_flags=c_flags)
             if target == "x86":
                 out["x86"] = {"selftest_mismatches": run_x86(image)}
+            elif target == "qemu":
+                run = run_qemu(image)
+                out["qemu"] = {"selftest_mismatches": run.mismatches, "reference_output": list(run.output),
+                               "seconds": run.seconds}
             else:
                 run = run_arm(image, name)
-                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles)}
+                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles),
+                              "reference_output": list(run.output)}
     return out
 
 
@@ -178,8 +185,9 @@ def build_info() -> dict:
 # ----------------------------------------------------------------------------- the package
 
 def build_package(out: str | Path, name: str, units: dict[str, Unit], config: dict, inputs: dict,
-                  plan: EvidencePlan = EvidencePlan(), log=print) -> PackageResult:
-    """Write the flight package of `units` (controller first) into `out`, atomically.
+                  plan: EvidencePlan = EvidencePlan(), log=print, sign_key: bytes | None = None) -> PackageResult:
+    """Write the flight package of `units` (controller first) into `out`, atomically; with
+    `sign_key` the manifest carries its HMAC-SHA256 signature (codegen.package.manifest).
 
     config: the configuration's values (codegen.package.config.PackageConfig.to_mapping());
     inputs: {"config" / "network" / "tanh": {"file": name, "sha256": of the file's bytes, ...}}."""
@@ -208,12 +216,13 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
                 raise ToolError("refusing to write the package: " + "; ".join(failures))
             info = build_info()
             files["ICD.md"] = render_icd(name, units, {**config, "inputs": inputs}, evidence, {
-                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"]})
+                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"],
+                "signed": sign_key is not None})
             atomic.write_text(tmp / "ICD.md", files["ICD.md"])
             body = {"generator": {"name": "staregen", "version": GENERATOR_VERSION}, "name": name,
                     "units": {k: {"entry": u.entry, "identity": u.identity()} for k, u in units.items()},
                     "config": config, "inputs": inputs, "build": info, "evidence": evidence}
-            doc = manifest.document({p: t.encode("utf-8") for p, t in files.items()}, body)
+            doc = manifest.document({p: t.encode("utf-8") for p, t in files.items()}, body, sign_key)
             atomic.write_text(tmp / manifest.MANIFEST, manifest.to_text(doc))
     except OSError as exc:
         raise ToolError(f"cannot write package folder {out}: {exc.strerror or exc}") from None
@@ -228,22 +237,51 @@ def _dig(doc, *keys) -> dict:
     return doc if isinstance(doc, dict) else {}
 
 
-def check_package(folder: str | Path, run: tuple[str, ...] = ()) -> tuple[dict, list[str], dict]:
-    """(manifest, problems, runs): the folder against its manifest and, for each target in `run`,
-    the self-test built with the package's CMakeLists (with the ARM reference step's cycles compared
-    to the manifest's). The self-test runs even on an edited folder: it tells whether the edit matters."""
-    doc, problems = manifest.check(folder)
+def _recorded_words(doc: dict) -> list[str] | None:
+    """The reference step's output words the manifest recorded from the Unicorn run, if well-formed."""
+    words = _dig(doc, "evidence", "package_build", "arm").get("reference_output")
+    ok = isinstance(words, list) and all(isinstance(w, str) and len(w) == 8 for w in words)
+    return words if ok else None
+
+
+def _qemu_problems(doc: dict, runs: dict) -> list[str]:
+    """The reference step's output words in QEMU against the Unicorn run's (this check's, else the
+    manifest's, recorded from the Unicorn run at generation)."""
+    want = runs["arm"]["reference_output"] if "arm" in runs else _recorded_words(doc)
+    got = runs["qemu"]["reference_output"]
+    if not want:
+        return ["qemu: no Unicorn reference output to compare with (add arm to --run)"]
+    if got != want:
+        return [f"qemu: reference step output words {' '.join(got)} differ from the Unicorn run's {' '.join(want)}"]
+    return []
+
+
+def check_package(folder: str | Path, run: tuple[str, ...] = (),
+                  key: bytes | None = None) -> tuple[dict, list[str], dict]:
+    """(manifest, problems, runs): the folder against its manifest (and its signature under `key`,
+    when given) and, for each target in `run`, the self-test built with the package's CMakeLists
+    (the ARM reference step's cycles compared to the manifest's, QEMU's output words to Unicorn's).
+    A folder that fails its check is never configured, compiled or run: its CMakeLists.txt is code
+    (execute_process) and an edited file is untrusted. What is built is a private copy of the
+    bytes that were checked."""
+    doc, problems = manifest.check(folder, key)
+    if problems or not run:
+        return doc, problems, {}
     runs = {}
-    for target in run:
-        try:
-            runs.update(run_package(Path(folder), doc["name"], (target,)))
-        except (FirmwareError, ToolError) as exc:
-            problems.append(f"{target}: the package does not build or run: {exc}")
+    with tempfile.TemporaryDirectory(prefix="staregen-check-") as tmp:
+        problems = manifest.copy_verified(folder, doc, tmp)    # build the bytes checked, not the folder
+        for target in run if not problems else ():
+            try:
+                runs.update(run_package(Path(tmp), doc["name"], (target,)))
+            except (FirmwareError, ToolError) as exc:
+                problems.append(f"{target}: the package does not build or run: {exc}")
     if "arm" in runs:
         want = _dig(doc, "evidence", "package_build", "arm", "reference_cycles")
         got = runs["arm"]["reference_cycles"]
         if want and got != want:
             problems.append(f"arm: reference step takes {got} cycles, the manifest says {want}")
+    if "qemu" in runs:
+        problems += _qemu_problems(doc, runs)
     problems += [f"{t}: self-test reports {r['selftest_mismatches']} mismatching words"
                  for t, r in runs.items() if r["selftest_mismatches"] != 0]
     return doc, problems, runs

@@ -1,11 +1,14 @@
 """Running a built flight-package image: the x86-64 executable natively, the STM32F417 ELF in
 the Cortex-M4 emulator, where `<name>_selftest()` runs plainly and then the reference step
 (`<name>_selftest_reference` + `<name>_step`, what main does after the self-test) runs under the
-cycle profiler in every memory mode."""
+cycle profiler in every memory mode; and the QEMU image in QEMU's netduinoplus2 (STM32F405), a
+second, independent emulator, which reports by semihosting and is killed past a time-out."""
 from __future__ import annotations
 
 import re
+import shutil
 import subprocess
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -15,7 +18,10 @@ from tools.m4.machine import Machine
 from tools.m4.profile import MODES, Profiler
 
 SELFTEST_MAX_INSNS = 200_000_000
+QEMU_TIMEOUT_S = 60.0
+QEMU_MACHINE = "netduinoplus2"
 _LINE = re.compile(r"selftest mismatches: (-?\d+)")
+_WORDS = re.compile(r"reference output:((?: [0-9a-f]{8})+)\n")
 
 
 @dataclass(frozen=True)
@@ -23,6 +29,14 @@ class ArmImageRun:
     mismatches: int
     step_cycles: dict[str, int]      # mode -> cycles of the reference step
     status: int                      # the reference step's status word
+    output: tuple[str, ...] = ()     # the reference step's output record, one hex word each
+
+
+@dataclass(frozen=True)
+class QemuRun:
+    mismatches: int
+    output: tuple[str, ...]          # the reference step's output record, one hex word each
+    seconds: float
 
 
 def run_x86(exe: str | Path) -> int:
@@ -49,6 +63,7 @@ def run_arm(elf: str | Path, name: str) -> ArmImageRun:
     plain.call("main", max_insns=SELFTEST_MAX_INSNS)
     mismatches = int.from_bytes(plain.read(image.symbol("sg_image_result"), 4), "little", signed=True)
     status = int.from_bytes(plain.read(image.symbol("sg_image_status"), 4), "little")
+    output = _output_words(plain, image)
     prof = Profiler(image, f"{name}_step")
     prof.machine.boot()
     state, inp, out = (image.symbol("_sarena") + off for off in (0, 0x400, 0x800))   # records of < 1 KB each
@@ -58,4 +73,47 @@ def run_arm(elf: str | Path, name: str) -> ArmImageRun:
     if len(prof.evaluations) != 1:
         raise ToolError(f"{Path(elf).name}: {len(prof.evaluations)} evaluations of {name}_step for one call")
     ref = prof.evaluations[0]
-    return ArmImageRun(mismatches, {m: int(ref.total[i]) for i, m in enumerate(MODES)}, status)
+    return ArmImageRun(mismatches, {m: int(ref.total[i]) for i, m in enumerate(MODES)}, status, output)
+
+
+def _output_words(machine: Machine, image: Image) -> tuple[str, ...]:
+    n = int.from_bytes(machine.read(image.symbol("sg_image_output_words"), 4), "little")
+    if not 1 <= n <= 256:
+        raise ToolError(f"{image.path.name}: sg_image_output_words is {n}")
+    raw = machine.read(image.symbol("sg_image_output"), 4 * n)
+    return tuple(f"{int.from_bytes(raw[i:i + 4], 'little'):08x}" for i in range(0, 4 * n, 4))
+
+
+def qemu_command(elf: str | Path) -> list[str]:
+    exe = shutil.which("qemu-system-arm")
+    if exe is None:
+        raise ToolError("qemu-system-arm not found on PATH (Debian's qemu-system-arm; see tools/setup.sh)")
+    # semihosting lets the image ask the host for a shell command (SYS_SYSTEM): the seccomp sandbox
+    # denies QEMU any new process, whatever the image asks
+    return [exe, "-M", QEMU_MACHINE, "-nodefaults", "-display", "none", "-monitor", "none", "-serial", "null",
+            "-sandbox", "on,obsolete=deny,elevateprivileges=deny,spawn=deny,resourcecontrol=deny",
+            "-semihosting-config", "enable=on,target=native", "-kernel", str(elf)]
+
+
+def run_qemu(elf: str | Path, timeout: float = QEMU_TIMEOUT_S) -> QemuRun:
+    """The QEMU image (firmware/package_build.py, target qemu) in QEMU's netduinoplus2: main runs
+    the self-test and one reference step and prints both by semihosting, then exits by SYS_EXIT.
+    QEMU is killed after `timeout` seconds (a hung image must not hang the caller)."""
+    t0 = time.perf_counter()
+    try:
+        res = subprocess.run(qemu_command(elf), capture_output=True, text=True, timeout=timeout,
+                             stdin=subprocess.DEVNULL, cwd=Path(elf).parent, check=False)
+    except subprocess.TimeoutExpired:
+        raise ToolError(f"qemu: {Path(elf).name} did not finish within {timeout:g} s (killed)") from None
+    except OSError as exc:
+        raise ToolError(f"qemu: cannot run ({exc.strerror or exc})") from None
+    seconds = time.perf_counter() - t0
+    text = res.stdout + res.stderr          # QEMU writes the semihosting console to stderr
+    m, words = _LINE.search(text), _WORDS.search(text)
+    if m is None or words is None or res.returncode not in (0, 1):
+        tail = (res.stderr.strip().splitlines() or ["no output"])[-1][:200]
+        raise ToolError(f"qemu: {Path(elf).name}: no self-test result (exit {res.returncode}; {tail})")
+    mismatches = int(m.group(1))
+    if (mismatches == 0) != (res.returncode == 0):
+        raise ToolError(f"qemu: exit status {res.returncode} contradicts {mismatches} mismatches")
+    return QemuRun(mismatches, tuple(words.group(1).split()), round(seconds, 2))

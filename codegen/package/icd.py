@@ -185,7 +185,7 @@ def render_icd(name: str, units: dict[str, Unit], config: dict, evidence: dict, 
     configuration `config` (the configuration file's mapping, plus "inputs": {role: {"file",
     "sha256"}}), `evidence` as tools/package.py measures it ({"units": {kind: {...}}, "clock_hz",
     "paper_budget_cycles", optionally "package_build"}), `flags` {"common", "arm_cpu",
-    "compiler"}. The same arguments give the same bytes."""
+    "compiler", optionally "signed": whether the manifest is signed}. The same arguments give the same bytes."""
     check_name(name)
     clock = int(evidence.get("clock_hz", 168_000_000))
     budget = int(evidence.get("paper_budget_cycles", 554_400))
@@ -202,5 +202,6 @@ def render_icd(name: str, units: dict[str, Unit], config: dict, evidence: dict, 
         "arm_cpu": _code(flags.get("arm_cpu", [])), "compiler": cell(flags.get("compiler", "")),
         "clock_mhz": f"{clock / 1e6:g}", "budget": budget, "budget_ms": f"{budget / clock * 1e3:g}",
         "package_build": [(cell(t), r.get("selftest_mismatches")) for t, r in evidence.get("package_build", {}).items()],
+        "signed": bool(flags.get("signed", False)),
     }
     return environment(TEMPLATES).get_template("ICD.md.j2").render(ctx)

@@ -4,10 +4,13 @@ For each unit, N vectors drawn from its gate classes (every class present, in th
 proportions; vector 0 is the first class's, the timing reference) are run through the golden
 model; the C holds {state in, input, expected output, expected state out} as uint32 words and
 `int <name>_selftest(void)` replays them through the flight step, counting mismatching words,
-every bit compared (NaN outputs are canonical on every target). Four floating-point environment
-checks (subnormals kept, round to nearest in both directions, no fused multiply-add in the
-self-test's own translation unit) add one each when they fail, so a board whose start-up code set flush-to-zero
-or a directed rounding mode fails the self-test even where the vectors would not show it.
+every bit compared (NaN outputs are canonical on every target). Five floating-point environment
+checks (subnormal results kept, subnormal operands not read as zero, round to nearest in both
+directions, no fused multiply-add in the self-test's own translation unit) add one each when they
+fail, so a board whose start-up code set flush-to-zero (FPSCR.FZ, MXCSR.FTZ), denormals-are-zero
+(MXCSR.DAZ) or a directed rounding mode fails the self-test even where the vectors would not show
+it. FPSCR.DN (default NaN) is not checked: it changes NaN payloads only, and the outputs do not
+depend on it (tests/tools/test_package_integrity.py, over the gate classes and random bits).
 """
 from __future__ import annotations
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen.package import config as pc
+from codegen.package.manifest import load_key
 from codegen.package.selftest import MAX_VECTORS
 from codegen.units.tanh.emit import params_sha256
 from codegen.units.tanh.params import load_params
@@ -33,6 +34,8 @@ def register(subparsers) -> None:
                    "includes the tanh unit)")
     p.add_argument("--out", required=True, metavar="DIR", help="package folder (new or empty, or replaced if it holds "
                    "exactly a staregen package)")
+    p.add_argument("--sign-key", default=None, metavar="FILE", help="key file (at least 32 random bytes, kept by "
+                   "you): sign the manifest with HMAC-SHA256 (`package check --verify-key FILE`)")
     add_evidence_arguments(p)
     p.set_defaults(func=run)
 
@@ -64,12 +67,12 @@ def file_sha256(path: Path) -> str:
 
 
 def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,
-             plan: EvidencePlan = EvidencePlan(), log=print, input_paths=()):
+             plan: EvidencePlan = EvidencePlan(), log=print, input_paths=(), sign_key: bytes | None = None):
     """The package of a validated configuration and network (also the pipeline's last stage);
     `input_paths`: the files read, which must not lie in the folder it replaces."""
     check_output_folder(out, package_owner, input_paths)
     units = package_units(cfg, network, tanh)
-    return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log)
+    return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log, sign_key)
 
 
 def summary(result) -> list[str]:
@@ -85,6 +88,7 @@ def summary(result) -> list[str]:
 
 def run(args: argparse.Namespace) -> int:
     plan = evidence_plan(args)
+    sign_key = load_key(args.sign_key) if args.sign_key is not None else None
     cfg = pc.load(args.config)
     network = art.load(args.network)
     tanh = load_params(args.tanh) if args.tanh is not None else None
@@ -97,6 +101,6 @@ def run(args: argparse.Namespace) -> int:
         inputs["tanh"] = {"file": tanh_path.name, "sha256": file_sha256(tanh_path),
                           "values_sha256": params_sha256(tanh, cfg.controller.control_period)}
     result = generate(cfg, network, Path(args.out), inputs, tanh, plan,
-                      input_paths=(args.config, args.network, args.tanh))
+                      input_paths=(args.config, args.network, args.tanh, args.sign_key), sign_key=sign_key)
     print("\n".join(summary(result)))
     return 0

@@ -28,6 +28,10 @@ CPACR_CP10_CP11 = 0xF << 20
 MAGIC = 0x0F000000
 
 FPSCR_POISON = (1 << 24) | (1 << 25) | (3 << 22)
+# `vmsr fpscr, r0; bx lr`, placed in the MAGIC page: Unicorn's register write of FPSCR does not
+# update every mode the FPU computes with (default-NaN mode stays off), the instruction does.
+_SET_FPSCR = MAGIC + 0x100
+_SET_FPSCR_CODE = bytes.fromhex("e1ee100a7047")
 STACK_PAINT = 0xA5A5A5A5
 DEFAULT_MAX_INSNS = 5_000_000
 
@@ -110,6 +114,15 @@ class Machine:
         if cpacr & CPACR_CP10_CP11 != CPACR_CP10_CP11 or fpscr & 0x07C00000:
             raise ToolError(f"startup did not enable the FPU as required "
                             f"(CPACR 0x{cpacr:08x}, FPSCR 0x{fpscr:08x})")
+
+    def set_fpscr(self, value: int) -> None:
+        """Set FPSCR as start-up code would (VMSR), e.g. to see what the self-test makes of
+        flush-to-zero, default-NaN or a directed rounding mode."""
+        self.uc.mem_write(_SET_FPSCR, _SET_FPSCR_CODE)
+        self.call(_SET_FPSCR, (value,), max_insns=10)
+        got = self.uc.reg_read(R.UC_ARM_REG_FPSCR) & 0x07C00000
+        if got != value & 0x07C00000:
+            raise ToolError(f"FPSCR reads 0x{got:08x} after writing 0x{value:08x}")
 
     # --- memory --------------------------------------------------------------------------
     def write(self, addr: int, data: bytes) -> None:

@@ -23,6 +23,8 @@ MAIN = r"""
 int main(int argc, char **argv)
 {
     if (argc > 1 && argv[1][0] == 'z') _mm_setcsr(_mm_getcsr() | 0x8040u);   /* FTZ + DAZ */
+    if (argc > 1 && argv[1][0] == 'f') _mm_setcsr(_mm_getcsr() | 0x8000u);   /* FTZ alone */
+    if (argc > 1 && argv[1][0] == 'a') _mm_setcsr(_mm_getcsr() | 0x0040u);   /* DAZ alone */
     if (argc > 1 && argv[1][0] == 'u') fesetround(FE_UPWARD);
     if (argc > 1 && argv[1][0] == 'd') fesetround(FE_DOWNWARD);
     if (argc > 1 && argv[1][0] == 't') fesetround(FE_TOWARDZERO);
@@ -92,7 +94,8 @@ def test_selftest_passes_and_counts_planted_faults(tmp_path, package_sources):
     assert env == 0 and mismatches > 0
 
 
-@pytest.mark.parametrize("mode, bits", [("z", 1), ("t", 2 | 4), ("d", 2), ("u", 4)])
+# every MXCSR bit the ICD names is caught: FTZ (bit 0), DAZ (bit 4, issue 25), the rounding control
+@pytest.mark.parametrize("mode, bits", [("z", 1 | 16), ("f", 1), ("a", 16), ("t", 2 | 4), ("d", 2), ("u", 4)])
 def test_fp_environment_checks(tmp_path, package_sources, mode, bits):
     files, _ = package_sources
     mismatches, env = run(build(tmp_path, files), mode)

@@ -200,6 +200,19 @@ CASES = [
     (["artifact", "random", "--shape", "\u0661\u0662-40-3", "--out", "{tmp}/a.json"], "--shape"),
     (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "--shape 10000-10000-10000"),
     (["dp", "build", "--data", "{tmp}/none", "--n-max", "1_000", "--out", "{tmp}/t.json"], "--n-max"),
+    # issue 25 (integrity)
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{file}"],
+     "a key needs at least 32 bytes"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{net}"],
+     "larger than 1024 bytes"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{dir}"],
+     "not a regular file"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{tmp}/none.key"],
+     "cannot read the key"),
+    (["package", "check", "{dir}", "--verify-key", "/dev/zero"], "not a regular file"),
+    (["package", "check", "{dir}", "--verify-key", "{file}"], "a key needs at least 32 bytes"),
+    (["package", "check", "{dir}", "--verify-key", "{tmp}/none.key"], "cannot read the key"),
+    (["package", "check", "{dir}", "--run", "x86,qemu2"], "unknown target 'qemu2'"),
 ]
 
 
