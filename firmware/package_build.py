@@ -20,6 +20,10 @@ HERE = Path(__file__).resolve().parent
 IMAGE_PROJECT = HERE / "package_image"
 TOOLCHAIN = IMAGE_PROJECT / "toolchain-arm-none-eabi.cmake"
 TARGETS = ("arm", "x86")
+COMPILERS = ("gcc", "clang")
+# compiler -> the toolchain file of the STM32F417 image and the programs it needs (x86: CMAKE_C_COMPILER).
+_ARM_TOOLCHAINS = {"gcc": (TOOLCHAIN, ("arm-none-eabi-gcc",)),
+                   "clang": (IMAGE_PROJECT / "toolchain-clang-arm.cmake", ("clang", "arm-none-eabi-gcc"))}
 _NAME = re.compile(r"[a-z][a-z0-9_]{0,30}")
 _FLAG = re.compile(r"-[A-Za-z0-9_=+.,-]+")
 
@@ -47,12 +51,24 @@ def _run(cmd: list[str], what: str) -> None:
         raise FirmwareError(f"package build ({what}): {_first_error(res.stdout + res.stderr)}")
 
 
+def _compiler_args(target: str, compiler: str) -> list[str]:
+    """The CMake arguments that choose `compiler` for `target`, after checking its programs exist."""
+    toolchain, programs = _ARM_TOOLCHAINS[compiler] if target == "arm" else (None, (compiler,))
+    for prog in programs:
+        if shutil.which(prog) is None:
+            raise FirmwareError(f"package build: {prog!r} not found on PATH (see tools/setup.sh)")
+    return [f"-DCMAKE_TOOLCHAIN_FILE={toolchain}"] if toolchain else [f"-DCMAKE_C_COMPILER={compiler}"]
+
+
 def build_image(package_dir: str | Path, name: str, target: str, build_dir: str | Path,
-                c_flags: Sequence[str] = ()) -> Path:
-    """Configure and build the image of `package_dir` for `target`; returns the ELF (arm) or the
-    executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
+                c_flags: Sequence[str] = (), compiler: str = "gcc") -> Path:
+    """Configure and build the image of `package_dir` for `target` with `compiler` (gcc or clang);
+    returns the ELF (arm) or the executable (x86). `c_flags` are appended to the project's
+    CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
+    if compiler not in COMPILERS:
+        raise FirmwareError(f"package build: unknown compiler {compiler!r} (choose from {', '.join(COMPILERS)})")
     if not _NAME.fullmatch(name):
         raise FirmwareError(f"package build: {name!r} is not a package name")
     for f in c_flags:
@@ -64,13 +80,8 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
     build_dir.mkdir(parents=True, exist_ok=True)
     cmake = _cmake()
     cmd = [cmake, "-S", str(IMAGE_PROJECT), "-B", str(build_dir), f"-DSG_PACKAGE_DIR={package_dir}",
-           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
-    if target == "arm":
-        if shutil.which("arm-none-eabi-gcc") is None:
-            raise FirmwareError("package build: 'arm-none-eabi-gcc' not found on PATH (see tools/setup.sh)")
-        cmd.append(f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAIN}")
-    else:
-        cmd.append("-DCMAKE_C_COMPILER=gcc")
+           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}",
+           *_compiler_args(target, compiler)]
     _run(cmd, "configure")
     _run([cmake, "--build", str(build_dir), "--", "-j2"], "compile")
     image = build_dir / ("image.elf" if target == "arm" else "image")

@@ -29,7 +29,7 @@ from codegen.package.selftest import SelftestVectors, make_vectors, selftest_sou
 from codegen.unit import Batch, Unit
 from firmware import arm, x86
 from firmware.errors import FirmwareError
-from firmware.flags import ARM_CPU, COMMON
+from firmware.flags import ARM_CPU, COMMON, GCC_ONLY, PORTABLE
 from firmware.package_build import build_image
 from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES
 from tools.errors import ToolError
@@ -92,7 +92,7 @@ def source_files(name: str, units: dict[str, Unit], vectors: list[SelftestVector
     files = _split_sources(units)
     files.update({f"selftest/{f}": t for f, t in selftest_sources(name, vectors).items()})
     files["CMakeLists.txt"] = cmake_lists(name, _in(files, "include/"), _in(files, "src/"), _in(files, "selftest/"),
-                                          list(COMMON), GENERATOR_VERSION)
+                                          list(PORTABLE), GENERATOR_VERSION, gcc_flags=list(GCC_ONLY))
     return files
 
 

@@ -193,7 +193,7 @@ float sg_tanhf(float x)
     uint32_t ux = sg_as_u32(x);
     uint32_t d = (ux << 1) - SG_TANH_D_FIRST;
     float r;
-    if (__builtin_expect(d >= SG_TANH_D_END, 0) != 0) {
+    if (SG_EXPECT(d >= SG_TANH_D_END, 0) != 0) {
         r = sg_tanh_outside(x, ux, d);
     } else {
         r = sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, ux);
@@ -271,7 +271,7 @@ static float sg_exp_outer(float x)
 float sg_expf(float x)
 {
     float r;
-    if (__builtin_expect(!(__builtin_fabsf(x) <= 87.0f), 0) != 0) {
+    if (SG_EXPECT(!(SG_FABSF(x) <= 87.0f), 0) != 0) {
         r = sg_exp_outer(x);
     } else {
         float t = (x * SG_INV_LN2) + SG_MAGIC;
@@ -294,7 +294,7 @@ float sg_logf(float x)
 {
     uint32_t ix = sg_as_u32(x);
     float kbias = 0.0f;
-    if (__builtin_expect((ix < 0x00800000u) || (ix >= 0x7f800000u), 0) != 0) {
+    if (SG_EXPECT((ix < 0x00800000u) || (ix >= 0x7f800000u), 0) != 0) {
         if ((ix << 1) == 0u) {
             return -sg_inf();
         }
@@ -367,7 +367,7 @@ static float sg_trig(float x, uint32_t shift)
     float w = jf * SG_PIO2_3;
     float hi = t2 - w;
     float lo = ((t2 - hi) - w) - (jf * SG_PIO2_4);
-    if (__builtin_expect(!(__builtin_fabsf(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
+    if (SG_EXPECT(!(SG_FABSF(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
         hi = (hi > SG_PIO4) ? SG_PIO4 : ((hi < -SG_PIO4) ? -SG_PIO4 : hi);
         lo = 0.0f;
     }
@@ -380,7 +380,7 @@ float sg_sinf(float x)
 {
     /* sin x rounds to x below 2^-12; also keeps sin(-0) = -0 and passes NaN. */
     float r;
-    if (!(__builtin_fabsf(x) >= 0x1p-12f)) {
+    if (!(SG_FABSF(x) >= 0x1p-12f)) {
         r = x;
     } else {
         r = sg_trig(x, 0u);
@@ -418,9 +418,9 @@ static float sg_asin_tail(float x, float z)
  */
 float sg_asinf(float x)
 {
-    float a = __builtin_fabsf(x);
+    float a = SG_FABSF(x);
     float r;
-    if (__builtin_expect(!(a <= 1.0f), 0) != 0) {
+    if (SG_EXPECT(!(a <= 1.0f), 0) != 0) {
         r = (x == x) ? sg_nan() : (x + x);
     } else if (a < 0.5f) {
         if (a < 0x1p-12f) {
@@ -430,7 +430,7 @@ float sg_asinf(float x)
         }
     } else {
         float z = (1.0f - a) * 0.5f;
-        float s = __builtin_sqrtf(z);
+        float s = SG_SQRTF(z);
         float u = (2.0f * sg_asin_tail(s, z)) - SG_PIO2_LO;
         float y = (s >= 0.3125f) ? ((SG_PIO2_HI - (2.0f * s)) - u) : (SG_PIO2_HI - ((2.0f * s) + u));
         r = (x < 0.0f) ? -y : y;
@@ -478,12 +478,12 @@ static float sg_atan2_special(float y, float x, float a, float b, uint32_t xneg)
  */
 float sg_atan2f(float y, float x)
 {
-    float a = __builtin_fabsf(y);
-    float b = __builtin_fabsf(x);
+    float a = SG_FABSF(y);
+    float b = SG_FABSF(x);
     uint32_t xneg = sg_as_u32(x) >> 31;
     float inf = sg_inf();
     float r;
-    if (__builtin_expect(((a > 0.0f) && (a < inf) && (b > 0.0f) && (b < inf)), 1) == 0) {
+    if (SG_EXPECT(((a > 0.0f) && (a < inf) && (b > 0.0f) && (b < inf)), 1) == 0) {
         r = sg_atan2_special(y, x, a, b, xneg);
     } else {
         _Bool swap = (a > b);
@@ -501,8 +501,69 @@ float sg_atan2f(float y, float x)
 
 float sg_sqrtf(float x)
 {
-    return __builtin_sqrtf(x);
+    return SG_SQRTF(x);
 }
+
+#if !SG_HAVE_BUILTINS
+/* The root of a positive finite x = M 2^(e - 23) (M the 24-bit significand, subnormals normalised):
+ * with e' = e rounded down to even and M' = M 2^(e - e'), sqrt x = sqrt(M' 2^23) 2^(e'/2 - 23).
+ * The root of M' 2^24 is taken one bit at a time (the schoolbook method in base 2: try bit b, keep it
+ * while (q + b)^2 fits), 25 bits: 24 of the result and the rounding bit. A nonzero remainder means
+ * more bits below, and a root is never exactly halfway between two floats, so rounding up when the
+ * rounding bit is set is round to nearest even. The exponent field is added to the significand's
+ * bits, so a rounding carry into the exponent is exact. */
+static float sg_sqrtf_positive(uint32_t ux)
+{
+    uint32_t m = ux & 0x007fffffu;
+    uint32_t e150 = ux >> 23; /* e + 150 for a normal x (e = field - 127): kept positive */
+    uint32_t rem;
+    uint32_t root = 0u;
+    uint32_t twice = 0u; /* 2 root, in the scale of the bit being tried */
+    uint32_t bit;
+    if (e150 == 0u) {
+        e150 = 1u;
+        while (m < 0x00800000u) { /* subnormal: normalise */
+            m <<= 1;
+            e150 -= 1u;
+        }
+    } else {
+        m |= 0x00800000u;
+    }
+    e150 += 23u; /* field + 23 = e + 150 (150 is even: e150 has e's parity) */
+    rem = ((e150 & 1u) != 0u) ? (m << 2) : (m << 1);
+    for (bit = 0x01000000u; bit != 0u; bit >>= 1) {
+        const uint32_t t = twice + bit;
+        if (t <= rem) {
+            twice = t + bit;
+            rem -= t;
+            root += bit;
+        }
+        rem <<= 1;
+    }
+    if (rem != 0u) {
+        root += root & 1u;
+    }
+    /* (root >> 1) holds the implicit bit: field = 126 + floor(e / 2) + 1 */
+    return sg_as_f32((root >> 1) + (((e150 >> 1) + 51u) << 23));
+}
+
+float sg_sqrtf_c99(float x)
+{
+    const uint32_t ux = sg_as_u32(x);
+    float r;
+    if (((ux & 0x7fffffffu) == 0u) || (ux == 0x7f800000u)) {
+        r = x; /* +-0, +Inf */
+    } else if ((ux & 0x7fffffffu) > 0x7f800000u) {
+        r = x + x; /* NaN: quieted by the FPU, as VSQRT and sqrtss do */
+    } else if ((ux >> 31) != 0u) {
+        const float z = x - x;
+        r = z / z; /* negative, -Inf: the FPU's default NaN, as VSQRT and sqrtss give */
+    } else {
+        r = sg_sqrtf_positive(ux);
+    }
+    return r;
+}
+#endif
 
 /* x^y = e^{y ln x} for x >= 0 (see sg_math.h for the special cases). */
 /* Coefficients of sg_powf_fused (sg_math.h): log2(1+f)/f on [sqrt(1/2) - 1, sqrt(2) - 1] (degree 7,
