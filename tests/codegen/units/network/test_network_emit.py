@@ -189,6 +189,22 @@ def arm_compile(src_dir, out, *extra):
     return out
 
 
+CLANG_TARGETS = {"x86": [], "arm": [f"--target={flags.CLANG_ARM_TARGET}", *flags.ARM_CPU]}
+
+
+@pytest.mark.parametrize("target", sorted(CLANG_TARGETS))
+@pytest.mark.parametrize("n_hidden", [40, 41])   # the two-neuron loop and the one-neuron loop
+def test_both_loop_shapes_build_with_clang_under_werror(tmp_path, n_hidden, target):
+    """clang's -Wunused-function (with -Werror) refuses a static the loop does not call: each
+    loop shape's tanh helpers are emitted only where used (issue 25, defect 17)."""
+    assert shutil.which("clang"), "clang missing: run tools/setup.sh"
+    write_sources(emit.network_sources(art.random_artifact((12, n_hidden, 3), seed=4)), tmp_path)
+    res = subprocess.run(["clang", *flags.PORTABLE, *CLANG_TARGETS[target], "-I", str(tmp_path), "-c",
+                          str(tmp_path / "network.c"), "-o", str(tmp_path / "network.o")], capture_output=True,
+                         text=True)
+    assert res.returncode == 0, res.stderr
+
+
 def test_arm_build_is_clean_and_the_mlp_loop_does_not_spill(artifact, tmp_path):
     """Cortex-M4: inputs and accumulators stay in registers (no spill), no call at all (tanh inline,
     its sign folded into the table: no VABS), a neuron's bias and weights loaded back to back and
