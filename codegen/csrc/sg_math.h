@@ -66,6 +66,16 @@
 
 #include <stdint.h>
 
+/* Every constant table of the package (sg_math's, the units') lies in a section of its own named
+ * .sg_tables.<table>, so that a linker script can place the package's tables, and nothing else of
+ * the firmware's read-only data, e.g. in CCM: .sg_tables : { *(.sg_tables.*) } > CCM AT > FLASH.
+ * One section per table: --gc-sections still drops an unused one. */
+#if defined(__GNUC__) || defined(__clang__)
+#define SG_TABLE(name) __attribute__((section(".sg_tables." #name)))
+#else
+#define SG_TABLE(name)
+#endif
+
 /* tanh(x) (MATLAB tansig(n) = 2/(1+exp(-2n)) - 1); odd, |result| <= 1, exactly +-1 for
  * |x| >= 9, exactly x for |x| < 2^-12. Table-driven, no division (the network's hot path). */
 float sg_tanhf(float x);

@@ -32,6 +32,10 @@ class ControllerUnit(Unit):
         self._sources = controller_sources(artifact, config, name)
         super().__init__(name, INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, BUDGETS)
 
+    @property
+    def integrity_symbol(self) -> str:
+        return f"{self.entry}_integrity_check"
+
     def identity(self) -> str:
         mode = ", PID only" if self.config.pid_only else ""
         return f"controller ({self.step_symbol}), network {self.artifact.shape_text} sha256 {self.artifact.sha256[:16]}{mode}"
