@@ -26,7 +26,7 @@ from codegen.package import manifest
 from codegen.package.cmake import cmake_lists
 from codegen.package.icd import render_icd
 from codegen.package.selftest import SelftestVectors, make_vectors, selftest_sources
-from codegen.unit import Batch, Unit
+from codegen.unit import Batch, Unit, words
 from firmware import arm, x86
 from firmware.errors import FirmwareError
 from firmware.flags import ARM_CPU, COMMON, GCC_ONLY, PORTABLE
@@ -107,6 +107,13 @@ def _quiet(_line: str) -> None:
     pass
 
 
+def record_bytes(unit: Unit) -> dict[str, int]:
+    """sizeof of each C record (input, output, state): the unit's packed dtypes, whose layout the
+    harness checks against the C's sizeof and offsetof."""
+    dtypes = {"input": unit.input_dtype, "output": unit.output_dtype, "state": unit.state_dtype}
+    return {role: d.itemsize for role, d in dtypes.items() if d is not None}
+
+
 def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=print) -> dict:
     """Gate, self-test vectors on the targets, cycles, memory of one unit."""
     t0 = time.perf_counter()
@@ -134,12 +141,14 @@ def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=prin
                  "classes": gate.counts, "pass": gate.ok,
                  "targets": {"golden": {"invariant_problems": len(gate.problems.get("golden", []))},
                              **{t: {"mismatches": gate.mismatches[t]} for t in TARGETS}}},
-        "selftest_vectors": {"n": vec.n, "classes": vec.classes, "targets": selftest},
+        "selftest_vectors": {"n": vec.n, "classes": vec.classes, "targets": selftest,
+                             "reference_output_words": [f"0x{w:08x}" for w in words(vec.output[:1])[0]]},
         "cycles": {"step": rep["cycles"], "reference": {m: rep["by_class"]["reference"][m]["max"] for m in MODES},
                    "per_class": plan.cycles_per_class, "table": rep["table"], "bound": rep["bound"],
                    "step_lenient": rep["cycles_lenient"], "functions": functions},
         "memory": {"flash_bytes": rep["flash_bytes"], "ram_bytes": rep["ram_bytes"],
                    "state_bytes": rep["state_bytes"], "stack_bytes": rep["stack_bytes"],
+                   "record_bytes": record_bytes(unit),
                    "tables_in": unit.tables_in},
         "budgets": rep["budgets"],
     }
@@ -156,7 +165,8 @@ def run_package(folder: Path, name: str, targets=TARGETS, c_flags=()) -> dict:
                 out["x86"] = {"selftest_mismatches": run_x86(image)}
             else:
                 run = run_arm(image, name)
-                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles)}
+                out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles),
+                              "selftest_cycles": run.selftest_cycles, "selftest_stack_bytes": run.selftest_stack_bytes}
     return out
 
 
@@ -205,7 +215,8 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
                 raise ToolError("refusing to write the package: " + "; ".join(failures))
             info = build_info()
             files["ICD.md"] = render_icd(name, units, {**config, "inputs": inputs}, evidence, {
-                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"]})
+                "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"],
+                "gcc_only": list(GCC_ONLY)})
             atomic.write_text(tmp / "ICD.md", files["ICD.md"])
             body = {"generator": {"name": "staregen", "version": GENERATOR_VERSION}, "name": name,
                     "units": {k: {"entry": u.entry, "identity": u.identity()} for k, u in units.items()},
