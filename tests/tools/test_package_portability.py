@@ -5,6 +5,7 @@ the C99 fallbacks of the GCC builtins give the same self-test words; nothing GNU
 compiler that does not define __GNUC__."""
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 from pathlib import Path
@@ -12,10 +13,12 @@ from pathlib import Path
 import pytest
 
 from codegen.artifact import random_artifact
-from firmware.flags import PORTABLE
+from firmware.flags import ARM_CC, ARM_CPU, CLANG_ARM_TARGET, GCC_ONLY, PORTABLE
 from firmware.package_build import build_image
 from host.control.nn_controller import default_package_config
 from host.sim.scenarios import package_units
+from tools.m4.elf import Image
+from tools.m4.machine import Machine
 from tools.package import EvidencePlan, build_package
 from tools.package_run import run_arm, run_x86
 
@@ -89,3 +92,50 @@ def test_nothing_gnu_only_reaches_a_compiler_without_gnu_c(package):
             elif own:
                 found |= set(GNU_ONLY.findall(line))
         assert found == set(), (src.name, found)
+
+
+def test_icd_states_what_the_manifest_measured(package, tmp_path):
+    """The generated ICD (defect 21) states the manifest's reference output words (and the STM32F417
+    image's reference step, run here, writes exactly them), record sizes, and the self-test's
+    cycles and stack measured in the emulator."""
+    doc = json.loads((package / "manifest.json").read_text())
+    icd = (package / "ICD.md").read_text()
+    ev = doc["evidence"]["units"]["controller"]
+    words = ev["selftest_vectors"]["reference_output_words"]
+    assert f"`{' '.join(words)}`" in icd
+    sizes = ev["memory"]["record_bytes"]
+    assert sizes == {"input": 64, "output": 4 * len(words), "state": 24}
+    for role, n in sizes.items():
+        assert f"`sizeof(stare_{role}_t)` = {n} B" in icd
+    arm = doc["evidence"]["package_build"]["arm"]
+    assert arm["selftest_cycles"]["ideal"] > 10 * arm["reference_cycles"]["ideal"] and arm["selftest_stack_bytes"] > 0
+    for mode, cycles in arm["selftest_cycles"].items():
+        assert f"{cycles} cycles {mode}" in icd
+    assert f"uses {arm['selftest_stack_bytes']} B of stack" in icd
+    assert "stare_integrity_check(&stare_state)" in icd
+    image = Image(build_image(package, "stare", "arm", tmp_path / "arm"))
+    machine = Machine(image)
+    machine.boot()
+    state, inp, out = (image.symbol("_sarena") + off for off in (0, 0x400, 0x800))
+    machine.call("stare_selftest_reference", (state, inp))
+    machine.call("stare_step", (state, inp, out))
+    got = [f"0x{int.from_bytes(machine.read(out + 4 * i, 4), 'little'):08x}" for i in range(len(words))]
+    assert got == words
+
+
+@pytest.mark.parametrize("compiler", ["gcc", "clang"])
+def test_every_package_table_is_in_a_sg_tables_section(package, tmp_path, compiler):
+    """The ICD's one-line CCM rule moves all the package's constant tables: the flight objects
+    have no other read-only or writable data section (the self-test's vectors stay with .rodata)."""
+    cc = [compiler, f"--target={CLANG_ARM_TARGET}"] if compiler == "clang" else [ARM_CC]
+    flags = PORTABLE + (GCC_ONLY if compiler == "gcc" else [])
+    for src in sorted((package / "src").glob("*.c")):
+        obj = tmp_path / (src.stem + ".o")
+        subprocess.run([*cc, *flags, *ARM_CPU, "-ffunction-sections", "-fdata-sections", "-DSG_FP_CONTRACT_OFF=1",
+                        "-I", str(package / "include"), "-c", str(src), "-o", str(obj)], check=True)
+        heads = subprocess.run(["arm-none-eabi-objdump", "-h", str(obj)], capture_output=True, text=True,
+                               check=True).stdout
+        data = {ln.split()[1]: int(ln.split()[2], 16) for ln in heads.splitlines()
+                if re.match(r"\s*\d+ \.(rodata|data|bss|sg_tables)", ln)}
+        assert {s for s, n in data.items() if n and not s.startswith(".sg_tables.")} == set(), (src.name, data)
+    assert any(s.startswith(".sg_tables.") for s in data)
