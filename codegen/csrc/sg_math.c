@@ -43,7 +43,7 @@ static float sg_as_f32(uint32_t u)
  * network loop (sg_inline_tanhf), ~31 as a call.
  */
 
-const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] SG_TABLE(sg_tanh_tab) = {
+const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] SG_TABLE(".sg_tables.sg_tanh_tab") = {
     /* BEGIN sg_tanh_tab: c, c0, c1, c2, c3, c4 */
     {0x1.1p-12f, 0x1.1p-12f, 0x1.fffffep-1f, -0x1.100012p-12f, -0x1.554f5cp-2f, 0x1.807d22p+0f},
     {0x1.3p-12f, 0x1.3p-12f, 0x1.fffffep-1f, -0x1.2ffff4p-12f, -0x1.554af4p-2f, 0x1.91be34p-2f},
@@ -530,7 +530,10 @@ static float sg_sqrtf_positive(uint32_t ux)
         m |= 0x00800000u;
     }
     e150 += 23u; /* field + 23 = e + 150 (150 is even: e150 has e's parity) */
-    rem = ((e150 & 1u) != 0u) ? (m << 2) : (m << 1);
+    rem = m << 1;
+    if ((e150 & 1u) != 0u) {
+        rem <<= 1;
+    }
     for (bit = 0x01000000u; bit != 0u; bit >>= 1) {
         const uint32_t t = twice + bit;
         if (t <= rem) {
@@ -556,8 +559,9 @@ float sg_sqrtf_c99(float x)
     } else if ((ux & 0x7fffffffu) > 0x7f800000u) {
         r = x + x; /* NaN: quieted by the FPU, as VSQRT and sqrtss do */
     } else if ((ux >> 31) != 0u) {
-        const float z = x - x;
-        r = z / z; /* negative, -Inf: the FPU's default NaN, as VSQRT and sqrtss give */
+        /* negative, -Inf: 0 / 0 (or NaN / NaN) at run time, the FPU's default NaN, as VSQRT and
+         * sqrtss give (a constant 0.0f / 0.0f would be folded to one NaN for every target) */
+        r = (x - x) / (x + (-x));
     } else {
         r = sg_sqrtf_positive(ux);
     }
@@ -569,7 +573,7 @@ float sg_sqrtf_c99(float x)
 /* Coefficients of sg_powf_fused (sg_math.h): log2(1+f)/f on [sqrt(1/2) - 1, sqrt(2) - 1] (degree 7,
  * absolute error of f P(f) 4.9e-8) and (2^r - 1)/r on [-1/2, 1/2] (degree 5, relative error of
  * 1 + r Q(r) 3.0e-9), float32 minimax fits rounded low order first. */
-const float sg_powf_fused_tab[14] SG_TABLE(sg_powf_fused_tab) = {
+const float sg_powf_fused_tab[14] SG_TABLE(".sg_tables.sg_powf_fused_tab") = {
     -0x1.2a5f1ap-3f, 0x1.e50a6ap-3f, -0x1.0011d6p-2f, 0x1.25992ap-2f,
     -0x1.70baf6p-2f, 0x1.ec7b3ep-2f, -0x1.7155b8p-1f, 0x1.715472p+0f,
     0x1.417a9cp-13f, 0x1.5f0948p-10f, 0x1.3b2dd2p-7f, 0x1.c6af7ap-5f,
@@ -578,7 +582,7 @@ const float sg_powf_fused_tab[14] SG_TABLE(sg_powf_fused_tab) = {
 
 /* sg_powf_tab (sg_math.h): rows {c, 1/c, log2 c} of the 32 intervals of z, then log2(1+r)/r =
  * a0 + r (a1 + r a2) and (2^(u/32) - 1)/u = b0 + u (b1 + u b2) (tools: docs/math.md). */
-const float sg_powf_tab_log[SG_POWF_TAB_N][3] SG_TABLE(sg_powf_tab_log) = {
+const float sg_powf_tab_log[SG_POWF_TAB_N][3] SG_TABLE(".sg_tables.sg_powf_tab_log") = {
     {0x1.6ap-1f, 0x1.6a13cep+0f, -0x1.001434p-1f},
     {0x1.72p-1f, 0x1.623fa8p+0f, -0x1.dfdd8ap-2f},
     {0x1.7ap-1f, 0x1.5ac056p+0f, -0x1.c04386p-2f},
@@ -612,9 +616,9 @@ const float sg_powf_tab_log[SG_POWF_TAB_N][3] SG_TABLE(sg_powf_tab_log) = {
     {0x1.5ap+0f, 0x1.7ad22p-1f, 0x1.bd0f2ep-2f},
     {0x1.62p+0f, 0x1.724288p-1f, 0x1.ded3fep-2f}
 };
-const float sg_powf_tab_poly[6] SG_TABLE(sg_powf_tab_poly) = {0x1.715476p+0f, -0x1.715daep-1f, 0x1.ec89cap-2f, 0x1.62e43p-6f, 0x1.ebfce6p-13f, 0x1.c6b186p-20f};
+const float sg_powf_tab_poly[6] SG_TABLE(".sg_tables.sg_powf_tab_poly") = {0x1.715476p+0f, -0x1.715daep-1f, 0x1.ec89cap-2f, 0x1.62e43p-6f, 0x1.ebfce6p-13f, 0x1.c6b186p-20f};
 /* bits of 2^(j/32), j = 0 .. 31 (float32, round to nearest) */
-const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] SG_TABLE(sg_powf_tab_exp2) = {
+const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] SG_TABLE(".sg_tables.sg_powf_tab_exp2") = {
     0x3f800000u, 0x3f82cd87u, 0x3f85aac3u, 0x3f88980fu, 0x3f8b95c2u, 0x3f8ea43au, 0x3f91c3d3u, 0x3f94f4f0u,
     0x3f9837f0u, 0x3f9b8d3au, 0x3f9ef532u, 0x3fa27043u, 0x3fa5fed7u, 0x3fa9a15bu, 0x3fad583fu, 0x3fb123f6u,
     0x3fb504f3u, 0x3fb8fbafu, 0x3fbd08a4u, 0x3fc12c4du, 0x3fc5672au, 0x3fc9b9beu, 0x3fce248cu, 0x3fd2a81eu,
@@ -623,7 +627,7 @@ const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] SG_TABLE(sg_powf_tab_exp2) = {
 
 /* sg_logf_tab (sg_math.h): rows {c, 1/c, ln c}, the intervals of sg_powf_tab_log but c = 1 in the
  * one holding 1 (ln c = 0 there: no cancellation near x = 1). */
-const float sg_logf_tab_rows[SG_POWF_TAB_N][3] SG_TABLE(sg_logf_tab_rows) = {
+const float sg_logf_tab_rows[SG_POWF_TAB_N][3] SG_TABLE(".sg_tables.sg_logf_tab_rows") = {
     {0x1.6ap-1f, 0x1.6a13cep+0f, -0x1.63003p-2f},
     {0x1.72p-1f, 0x1.623fa8p+0f, -0x1.4c9e0ap-2f},
     {0x1.7ap-1f, 0x1.5ac056p+0f, -0x1.36b678p-2f},

@@ -55,7 +55,7 @@
 #define SG_HAVE_BUILTINS 0
 #define SG_FABSF(x) sg_fabsf_c99(x)
 #define SG_SQRTF(x) sg_sqrtf_c99(x)
-#define SG_EXPECT(c, v) (c)
+#define SG_EXPECT(c, v) ((c) ? 1 : 0)
 #endif
 
 /* With math errno on (GCC's and clang's default on most hosts) __builtin_sqrtf calls libm's sqrtf
@@ -66,14 +66,15 @@
 
 #include <stdint.h>
 
-/* Every constant table of the package (sg_math's, the units') lies in a section of its own named
- * .sg_tables.<table>, so that a linker script can place the package's tables, and nothing else of
- * the firmware's read-only data, e.g. in CCM: .sg_tables : { *(.sg_tables.*) } > CCM AT > FLASH.
+/* Every constant table of the package (sg_math's, the units') lies in a section of its own,
+ * SG_TABLE(".sg_tables.<table>"), so that a linker script can place the package's tables, and
+ * nothing else of the firmware's read-only data, e.g. in CCM:
+ *   .sg_tables : { *(.sg_tables .sg_tables.*) } > CCM AT > FLASH
  * One section per table: --gc-sections still drops an unused one. */
 #if defined(__GNUC__) || defined(__clang__)
-#define SG_TABLE(name) __attribute__((section(".sg_tables." #name)))
+#define SG_TABLE(section_name) __attribute__((section(section_name)))
 #else
-#define SG_TABLE(name)
+#define SG_TABLE(section_name)
 #endif
 
 /* tanh(x) (MATLAB tansig(n) = 2/(1+exp(-2n)) - 1); odd, |result| <= 1, exactly +-1 for
