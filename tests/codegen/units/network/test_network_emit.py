@@ -75,7 +75,7 @@ def test_constants_are_exact_and_in_consumption_order(artifact, sources):
     want = np.concatenate([np.concatenate([[f.b1[j]], f.W1[j], f.W2[:, j]])
                            for j in range(artifact.n_hidden)]).astype(np.float64)
     np.testing.assert_array_equal(got, want)
-    b2 = c[c.index("network_b2[NETWORK_N_OUT] ="):].split(";")[0]
+    b2 = c[c.index("network_b2[NETWORK_N_OUT] SG_TABLE("):].split(";")[0]
     np.testing.assert_array_equal(np.array(hex_literals(b2)), f.b2.astype(np.float64))
     # this artifact's training ranges are symmetric (or [-1.2, 0]): every input is raw, no offset table
     assert f.centred_inputs == [] and "network_in_xoffset[" not in c
