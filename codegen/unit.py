@@ -144,6 +144,11 @@ class Unit(ABC):
         return f"{self.entry}_init" if self.stateful else None
 
     @property
+    def integrity_symbol(self) -> str | None:
+        """`uint32_t f(state *)` that checks the unit's constant tables (0: intact), if it has one."""
+        return None
+
+    @property
     def c_types(self) -> dict[str, str]:
         """C type of each record ("input", "output", and "state" if stateful): a struct name
         (sizeof and offsetof of every field are checked) or an array type like float[N_IN]."""

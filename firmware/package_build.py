@@ -23,6 +23,10 @@ IMAGE_PROJECT = HERE / "package_image"
 TOOLCHAIN = IMAGE_PROJECT / "toolchain-arm-none-eabi.cmake"
 LINKER_SCRIPT = HERE / "stm32f417.ld"
 TARGETS = ("arm", "qemu", "x86")
+COMPILERS = ("gcc", "clang")
+# compiler -> the toolchain file of the STM32F417 image and the programs it needs (x86: CMAKE_C_COMPILER).
+_ARM_TOOLCHAINS = {"gcc": (TOOLCHAIN, ("arm-none-eabi-gcc",)),
+                   "clang": (IMAGE_PROJECT / "toolchain-clang-arm.cmake", ("clang", "arm-none-eabi-gcc"))}
 # QEMU 7.2's netduinoplus2 (STM32F405) maps no CCM at 0x10000000 (`info mtree`: flash, 192 KB of SRAM
 # at 0x20000000, peripherals): its image keeps the constant tables in the top 64 KB of that SRAM,
 # above the 128 KB the STM32F417 map uses, so the copy to RAM and its CRC run as on the board.
@@ -65,13 +69,25 @@ def qemu_linker_script(build_dir: Path) -> Path:
     return path
 
 
+def _compiler_args(target: str, compiler: str) -> list[str]:
+    """The CMake arguments that choose `compiler` for `target` (x86, or arm/qemu: an ARM image),
+    after checking its programs exist."""
+    toolchain, programs = _ARM_TOOLCHAINS[compiler] if target != "x86" else (None, (compiler,))
+    for prog in programs:
+        if shutil.which(prog) is None:
+            raise FirmwareError(f"package build: {prog!r} not found on PATH (see tools/setup.sh)")
+    return [f"-DCMAKE_TOOLCHAIN_FILE={toolchain}"] if toolchain else [f"-DCMAKE_C_COMPILER={compiler}"]
+
+
 def build_image(package_dir: str | Path, name: str, target: str, build_dir: str | Path,
-                c_flags: Sequence[str] = ()) -> Path:
-    """Configure and build the image of `package_dir` for `target`; returns the ELF (arm, qemu) or
-    the executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a
-    fast-math flag to see the guard)."""
+                c_flags: Sequence[str] = (), compiler: str = "gcc") -> Path:
+    """Configure and build the image of `package_dir` for `target` with `compiler` (gcc or clang);
+    returns the ELF (arm, qemu) or the executable (x86). `c_flags` are appended to the project's
+    CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
+    if compiler not in COMPILERS:
+        raise FirmwareError(f"package build: unknown compiler {compiler!r} (choose from {', '.join(COMPILERS)})")
     if not _NAME.fullmatch(name):
         raise FirmwareError(f"package build: {name!r} is not a package name")
     for f in c_flags:
@@ -84,15 +100,10 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
     cmake = _cmake()
     cmake_target = "x86" if target == "x86" else "arm"      # the QEMU image is an ARM image
     cmd = [cmake, "-S", str(IMAGE_PROJECT), "-B", str(build_dir), f"-DSG_PACKAGE_DIR={package_dir}",
-           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={cmake_target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}"]
-    if target in ("arm", "qemu"):
-        if shutil.which("arm-none-eabi-gcc") is None:
-            raise FirmwareError("package build: 'arm-none-eabi-gcc' not found on PATH (see tools/setup.sh)")
-        cmd.append(f"-DCMAKE_TOOLCHAIN_FILE={TOOLCHAIN}")
+           f"-DSG_PACKAGE_NAME={name}", f"-DSG_TARGET={cmake_target}", f"-DSG_EXTRA_C_FLAGS={' '.join(c_flags)}",
+           *_compiler_args(target, compiler)]
     if target == "qemu":
         cmd += ["-DSG_SEMIHOSTING=ON", f"-DSG_LINKER_SCRIPT={qemu_linker_script(build_dir)}"]
-    elif target == "x86":
-        cmd.append("-DCMAKE_C_COMPILER=gcc")
     _run(cmd, "configure")
     _run([cmake, "--build", str(build_dir), "--", "-j2"], "compile")
     image = build_dir / ("image" if target == "x86" else "image.elf")

@@ -27,10 +27,10 @@ from codegen.package import manifest
 from codegen.package.cmake import cmake_lists
 from codegen.package.icd import render_icd
 from codegen.package.selftest import SelftestVectors, make_vectors, selftest_sources
-from codegen.unit import Batch, Unit
+from codegen.unit import Batch, Unit, words
 from firmware import arm, x86
 from firmware.errors import FirmwareError
-from firmware.flags import ARM_CPU, COMMON
+from firmware.flags import ARM_CPU, COMMON, GCC_ONLY, PORTABLE
 from firmware.package_build import build_image
 from tools.cycles import CLOCK_HZ, PAPER_BUDGET_CYCLES
 from tools.errors import ToolError
@@ -95,7 +95,7 @@ def source_files(name: str, units: dict[str, Unit], vectors: list[SelftestVector
     files = _split_sources(units)
     files.update({f"selftest/{f}": t for f, t in selftest_sources(name, vectors).items()})
     files["CMakeLists.txt"] = cmake_lists(name, _in(files, "include/"), _in(files, "src/"), _in(files, "selftest/"),
-                                          list(COMMON), GENERATOR_VERSION)
+                                          list(PORTABLE), GENERATOR_VERSION, gcc_flags=list(GCC_ONLY))
     return files
 
 
@@ -108,6 +108,13 @@ def _in(files: dict[str, str], folder: str) -> list[str]:
 
 def _quiet(_line: str) -> None:
     pass
+
+
+def record_bytes(unit: Unit) -> dict[str, int]:
+    """sizeof of each C record (input, output, state): the unit's packed dtypes, whose layout the
+    harness checks against the C's sizeof and offsetof."""
+    dtypes = {"input": unit.input_dtype, "output": unit.output_dtype, "state": unit.state_dtype}
+    return {role: d.itemsize for role, d in dtypes.items() if d is not None}
 
 
 def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=print) -> dict:
@@ -137,12 +144,14 @@ def unit_evidence(unit: Unit, vec: SelftestVectors, plan: EvidencePlan, log=prin
                  "classes": gate.counts, "pass": gate.ok,
                  "targets": {"golden": {"invariant_problems": len(gate.problems.get("golden", []))},
                              **{t: {"mismatches": gate.mismatches[t]} for t in TARGETS}}},
-        "selftest_vectors": {"n": vec.n, "classes": vec.classes, "targets": selftest},
+        "selftest_vectors": {"n": vec.n, "classes": vec.classes, "targets": selftest,
+                             "reference_output_words": [f"0x{w:08x}" for w in words(vec.output[:1])[0]]},
         "cycles": {"step": rep["cycles"], "reference": {m: rep["by_class"]["reference"][m]["max"] for m in MODES},
                    "per_class": plan.cycles_per_class, "table": rep["table"], "bound": rep["bound"],
                    "step_lenient": rep["cycles_lenient"], "functions": functions},
         "memory": {"flash_bytes": rep["flash_bytes"], "ram_bytes": rep["ram_bytes"],
                    "state_bytes": rep["state_bytes"], "stack_bytes": rep["stack_bytes"],
+                   "record_bytes": record_bytes(unit),
                    "tables_in": unit.tables_in},
         "budgets": rep["budgets"],
     }
@@ -166,7 +175,8 @@ def run_package(folder: Path, name: str, targets=TARGETS, c_flags=(), work: Path
             else:
                 run = run_arm(image, name)
                 out["arm"] = {"selftest_mismatches": run.mismatches, "reference_cycles": dict(run.step_cycles),
-                              "reference_output": list(run.output)}
+                              "reference_output": list(run.output), "selftest_cycles": run.selftest_cycles,
+                              "selftest_stack_bytes": run.selftest_stack_bytes}
     return out
 
 
@@ -217,7 +227,7 @@ def build_package(out: str | Path, name: str, units: dict[str, Unit], config: di
             info = build_info()
             files["ICD.md"] = render_icd(name, units, {**config, "inputs": inputs}, evidence, {
                 "common": info["flags"], "arm_cpu": info["arm_cpu"], "compiler": info["compilers"]["arm"],
-                "signed": sign_key is not None})
+                "signed": sign_key is not None, "gcc_only": list(GCC_ONLY)})
             atomic.write_text(tmp / "ICD.md", files["ICD.md"])
             body = {"generator": {"name": "staregen", "version": GENERATOR_VERSION}, "name": name,
                     "units": {k: {"entry": u.entry, "identity": u.identity()} for k, u in units.items()},

@@ -83,7 +83,7 @@ def map_objects(map_file: Path) -> dict[str, dict[str, int]]:
             row["flash"] += size
         elif _in(addr, SRAM) or _in(addr, CCM):
             row["ram"] += size
-            if name.startswith((".data", ".rodata")):
+            if name.startswith((".data", ".rodata", ".sg_tables")):
                 row["flash"] += size  # its initial values are stored in flash (copied at start-up)
     return out
 

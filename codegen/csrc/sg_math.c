@@ -43,7 +43,7 @@ static float sg_as_f32(uint32_t u)
  * network loop (sg_inline_tanhf), ~31 as a call.
  */
 
-const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] = {
+const float sg_tanh_tab[SG_TANH_N][SG_TANH_COLS] SG_TABLE(".sg_tables.sg_tanh_tab") = {
     /* BEGIN sg_tanh_tab: c, c0, c1, c2, c3, c4 */
     {0x1.1p-12f, 0x1.1p-12f, 0x1.fffffep-1f, -0x1.100012p-12f, -0x1.554f5cp-2f, 0x1.807d22p+0f},
     {0x1.3p-12f, 0x1.3p-12f, 0x1.fffffep-1f, -0x1.2ffff4p-12f, -0x1.554af4p-2f, 0x1.91be34p-2f},
@@ -193,7 +193,7 @@ float sg_tanhf(float x)
     uint32_t ux = sg_as_u32(x);
     uint32_t d = (ux << 1) - SG_TANH_D_FIRST;
     float r;
-    if (__builtin_expect(d >= SG_TANH_D_END, 0) != 0) {
+    if (SG_EXPECT(d >= SG_TANH_D_END, 0) != 0) {
         r = sg_tanh_outside(x, ux, d);
     } else {
         r = sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, ux);
@@ -271,7 +271,7 @@ static float sg_exp_outer(float x)
 float sg_expf(float x)
 {
     float r;
-    if (__builtin_expect(!(__builtin_fabsf(x) <= 87.0f), 0) != 0) {
+    if (SG_EXPECT(!(SG_FABSF(x) <= 87.0f), 0) != 0) {
         r = sg_exp_outer(x);
     } else {
         float t = (x * SG_INV_LN2) + SG_MAGIC;
@@ -294,7 +294,7 @@ float sg_logf(float x)
 {
     uint32_t ix = sg_as_u32(x);
     float kbias = 0.0f;
-    if (__builtin_expect((ix < 0x00800000u) || (ix >= 0x7f800000u), 0) != 0) {
+    if (SG_EXPECT((ix < 0x00800000u) || (ix >= 0x7f800000u), 0) != 0) {
         if ((ix << 1) == 0u) {
             return -sg_inf();
         }
@@ -367,7 +367,7 @@ static float sg_trig(float x, uint32_t shift)
     float w = jf * SG_PIO2_3;
     float hi = t2 - w;
     float lo = ((t2 - hi) - w) - (jf * SG_PIO2_4);
-    if (__builtin_expect(!(__builtin_fabsf(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
+    if (SG_EXPECT(!(SG_FABSF(x) <= SG_TRIG_MAX_ARG), 0) != 0) {
         hi = (hi > SG_PIO4) ? SG_PIO4 : ((hi < -SG_PIO4) ? -SG_PIO4 : hi);
         lo = 0.0f;
     }
@@ -380,7 +380,7 @@ float sg_sinf(float x)
 {
     /* sin x rounds to x below 2^-12; also keeps sin(-0) = -0 and passes NaN. */
     float r;
-    if (!(__builtin_fabsf(x) >= 0x1p-12f)) {
+    if (!(SG_FABSF(x) >= 0x1p-12f)) {
         r = x;
     } else {
         r = sg_trig(x, 0u);
@@ -418,9 +418,9 @@ static float sg_asin_tail(float x, float z)
  */
 float sg_asinf(float x)
 {
-    float a = __builtin_fabsf(x);
+    float a = SG_FABSF(x);
     float r;
-    if (__builtin_expect(!(a <= 1.0f), 0) != 0) {
+    if (SG_EXPECT(!(a <= 1.0f), 0) != 0) {
         r = (x == x) ? sg_nan() : (x + x);
     } else if (a < 0.5f) {
         if (a < 0x1p-12f) {
@@ -430,7 +430,7 @@ float sg_asinf(float x)
         }
     } else {
         float z = (1.0f - a) * 0.5f;
-        float s = __builtin_sqrtf(z);
+        float s = SG_SQRTF(z);
         float u = (2.0f * sg_asin_tail(s, z)) - SG_PIO2_LO;
         float y = (s >= 0.3125f) ? ((SG_PIO2_HI - (2.0f * s)) - u) : (SG_PIO2_HI - ((2.0f * s) + u));
         r = (x < 0.0f) ? -y : y;
@@ -478,12 +478,12 @@ static float sg_atan2_special(float y, float x, float a, float b, uint32_t xneg)
  */
 float sg_atan2f(float y, float x)
 {
-    float a = __builtin_fabsf(y);
-    float b = __builtin_fabsf(x);
+    float a = SG_FABSF(y);
+    float b = SG_FABSF(x);
     uint32_t xneg = sg_as_u32(x) >> 31;
     float inf = sg_inf();
     float r;
-    if (__builtin_expect(((a > 0.0f) && (a < inf) && (b > 0.0f) && (b < inf)), 1) == 0) {
+    if (SG_EXPECT(((a > 0.0f) && (a < inf) && (b > 0.0f) && (b < inf)), 1) == 0) {
         r = sg_atan2_special(y, x, a, b, xneg);
     } else {
         _Bool swap = (a > b);
@@ -501,14 +501,79 @@ float sg_atan2f(float y, float x)
 
 float sg_sqrtf(float x)
 {
-    return __builtin_sqrtf(x);
+    return SG_SQRTF(x);
 }
+
+#if !SG_HAVE_BUILTINS
+/* The root of a positive finite x = M 2^(e - 23) (M the 24-bit significand, subnormals normalised):
+ * with e' = e rounded down to even and M' = M 2^(e - e'), sqrt x = sqrt(M' 2^23) 2^(e'/2 - 23).
+ * The root of M' 2^24 is taken one bit at a time (the schoolbook method in base 2: try bit b, keep it
+ * while (q + b)^2 fits), 25 bits: 24 of the result and the rounding bit. A nonzero remainder means
+ * more bits below, and a root is never exactly halfway between two floats, so rounding up when the
+ * rounding bit is set is round to nearest even. The exponent field is added to the significand's
+ * bits, so a rounding carry into the exponent is exact. */
+static float sg_sqrtf_positive(uint32_t ux)
+{
+    uint32_t m = ux & 0x007fffffu;
+    uint32_t e150 = ux >> 23; /* e + 150 for a normal x (e = field - 127): kept positive */
+    uint32_t rem;
+    uint32_t root = 0u;
+    uint32_t twice = 0u; /* 2 root, in the scale of the bit being tried */
+    uint32_t bit;
+    if (e150 == 0u) {
+        e150 = 1u;
+        while (m < 0x00800000u) { /* subnormal: normalise */
+            m <<= 1;
+            e150 -= 1u;
+        }
+    } else {
+        m |= 0x00800000u;
+    }
+    e150 += 23u; /* field + 23 = e + 150 (150 is even: e150 has e's parity) */
+    rem = m << 1;
+    if ((e150 & 1u) != 0u) {
+        rem <<= 1;
+    }
+    for (bit = 0x01000000u; bit != 0u; bit >>= 1) {
+        const uint32_t t = twice + bit;
+        if (t <= rem) {
+            twice = t + bit;
+            rem -= t;
+            root += bit;
+        }
+        rem <<= 1;
+    }
+    if (rem != 0u) {
+        root += root & 1u;
+    }
+    /* (root >> 1) holds the implicit bit: field = 126 + floor(e / 2) + 1 */
+    return sg_as_f32((root >> 1) + (((e150 >> 1) + 51u) << 23));
+}
+
+float sg_sqrtf_c99(float x)
+{
+    const uint32_t ux = sg_as_u32(x);
+    float r;
+    if (((ux & 0x7fffffffu) == 0u) || (ux == 0x7f800000u)) {
+        r = x; /* +-0, +Inf */
+    } else if ((ux & 0x7fffffffu) > 0x7f800000u) {
+        r = x + x; /* NaN: quieted by the FPU, as VSQRT and sqrtss do */
+    } else if ((ux >> 31) != 0u) {
+        /* negative, -Inf: 0 / 0 (or NaN / NaN) at run time, the FPU's default NaN, as VSQRT and
+         * sqrtss give (a constant 0.0f / 0.0f would be folded to one NaN for every target) */
+        r = (x - x) / (x + (-x));
+    } else {
+        r = sg_sqrtf_positive(ux);
+    }
+    return r;
+}
+#endif
 
 /* x^y = e^{y ln x} for x >= 0 (see sg_math.h for the special cases). */
 /* Coefficients of sg_powf_fused (sg_math.h): log2(1+f)/f on [sqrt(1/2) - 1, sqrt(2) - 1] (degree 7,
  * absolute error of f P(f) 4.9e-8) and (2^r - 1)/r on [-1/2, 1/2] (degree 5, relative error of
  * 1 + r Q(r) 3.0e-9), float32 minimax fits rounded low order first. */
-const float sg_powf_fused_tab[14] = {
+const float sg_powf_fused_tab[14] SG_TABLE(".sg_tables.sg_powf_fused_tab") = {
     -0x1.2a5f1ap-3f, 0x1.e50a6ap-3f, -0x1.0011d6p-2f, 0x1.25992ap-2f,
     -0x1.70baf6p-2f, 0x1.ec7b3ep-2f, -0x1.7155b8p-1f, 0x1.715472p+0f,
     0x1.417a9cp-13f, 0x1.5f0948p-10f, 0x1.3b2dd2p-7f, 0x1.c6af7ap-5f,
@@ -517,7 +582,7 @@ const float sg_powf_fused_tab[14] = {
 
 /* sg_powf_tab (sg_math.h): rows {c, 1/c, log2 c} of the 32 intervals of z, then log2(1+r)/r =
  * a0 + r (a1 + r a2) and (2^(u/32) - 1)/u = b0 + u (b1 + u b2) (tools: docs/math.md). */
-const float sg_powf_tab_log[SG_POWF_TAB_N][3] = {
+const float sg_powf_tab_log[SG_POWF_TAB_N][3] SG_TABLE(".sg_tables.sg_powf_tab_log") = {
     {0x1.6ap-1f, 0x1.6a13cep+0f, -0x1.001434p-1f},
     {0x1.72p-1f, 0x1.623fa8p+0f, -0x1.dfdd8ap-2f},
     {0x1.7ap-1f, 0x1.5ac056p+0f, -0x1.c04386p-2f},
@@ -551,9 +616,9 @@ const float sg_powf_tab_log[SG_POWF_TAB_N][3] = {
     {0x1.5ap+0f, 0x1.7ad22p-1f, 0x1.bd0f2ep-2f},
     {0x1.62p+0f, 0x1.724288p-1f, 0x1.ded3fep-2f}
 };
-const float sg_powf_tab_poly[6] = {0x1.715476p+0f, -0x1.715daep-1f, 0x1.ec89cap-2f, 0x1.62e43p-6f, 0x1.ebfce6p-13f, 0x1.c6b186p-20f};
+const float sg_powf_tab_poly[6] SG_TABLE(".sg_tables.sg_powf_tab_poly") = {0x1.715476p+0f, -0x1.715daep-1f, 0x1.ec89cap-2f, 0x1.62e43p-6f, 0x1.ebfce6p-13f, 0x1.c6b186p-20f};
 /* bits of 2^(j/32), j = 0 .. 31 (float32, round to nearest) */
-const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] = {
+const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] SG_TABLE(".sg_tables.sg_powf_tab_exp2") = {
     0x3f800000u, 0x3f82cd87u, 0x3f85aac3u, 0x3f88980fu, 0x3f8b95c2u, 0x3f8ea43au, 0x3f91c3d3u, 0x3f94f4f0u,
     0x3f9837f0u, 0x3f9b8d3au, 0x3f9ef532u, 0x3fa27043u, 0x3fa5fed7u, 0x3fa9a15bu, 0x3fad583fu, 0x3fb123f6u,
     0x3fb504f3u, 0x3fb8fbafu, 0x3fbd08a4u, 0x3fc12c4du, 0x3fc5672au, 0x3fc9b9beu, 0x3fce248cu, 0x3fd2a81eu,
@@ -562,7 +627,7 @@ const uint32_t sg_powf_tab_exp2[SG_POWF_TAB_N] = {
 
 /* sg_logf_tab (sg_math.h): rows {c, 1/c, ln c}, the intervals of sg_powf_tab_log but c = 1 in the
  * one holding 1 (ln c = 0 there: no cancellation near x = 1). */
-const float sg_logf_tab_rows[SG_POWF_TAB_N][3] = {
+const float sg_logf_tab_rows[SG_POWF_TAB_N][3] SG_TABLE(".sg_tables.sg_logf_tab_rows") = {
     {0x1.6ap-1f, 0x1.6a13cep+0f, -0x1.63003p-2f},
     {0x1.72p-1f, 0x1.623fa8p+0f, -0x1.4c9e0ap-2f},
     {0x1.7ap-1f, 0x1.5ac056p+0f, -0x1.36b678p-2f},

@@ -43,7 +43,39 @@
 #error "sg_math: GNU C mode contracts a*b+c into fused multiply-adds by default; build with -std=c99, or add -ffp-contract=off -DSG_FP_CONTRACT_OFF"
 #endif
 
+/* GCC's builtins where the compiler has them (GCC, clang, armclang); otherwise, or with
+ * -DSG_NO_BUILTINS (how the tests build them), portable C99 with the same bits: fabs by the sign
+ * bit, sqrt correctly rounded in integer arithmetic (sg_sqrtf_c99), no branch hint. */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(SG_NO_BUILTINS)
+#define SG_HAVE_BUILTINS 1
+#define SG_FABSF(x) __builtin_fabsf(x)
+#define SG_SQRTF(x) __builtin_sqrtf(x)
+#define SG_EXPECT(c, v) __builtin_expect((c), (v))
+#else
+#define SG_HAVE_BUILTINS 0
+#define SG_FABSF(x) sg_fabsf_c99(x)
+#define SG_SQRTF(x) sg_sqrtf_c99(x)
+#define SG_EXPECT(c, v) ((c) ? 1 : 0)
+#endif
+
+/* With math errno on (GCC's and clang's default on most hosts) __builtin_sqrtf calls libm's sqrtf
+ * for a negative argument, to set errno: the "no libm" promise would break silently. */
+#if SG_HAVE_BUILTINS && !defined(__NO_MATH_ERRNO__)
+#error "sg_math: math errno is on, so sqrt would call libm's sqrtf; build with -fno-math-errno"
+#endif
+
 #include <stdint.h>
+
+/* Every constant table of the package (sg_math's, the units') lies in a section of its own,
+ * SG_TABLE(".sg_tables.<table>"), so that a linker script can place the package's tables, and
+ * nothing else of the firmware's read-only data, e.g. in CCM:
+ *   .sg_tables : { *(.sg_tables .sg_tables.*) } > CCM AT > FLASH
+ * One section per table: --gc-sections still drops an unused one. */
+#if defined(__GNUC__) || defined(__clang__)
+#define SG_TABLE(section_name) __attribute__((section(section_name)))
+#else
+#define SG_TABLE(section_name)
+#endif
 
 /* tanh(x) (MATLAB tansig(n) = 2/(1+exp(-2n)) - 1); odd, |result| <= 1, exactly +-1 for
  * |x| >= 9, exactly x for |x| < 2^-12. Table-driven, no division (the network's hot path). */
@@ -93,6 +125,21 @@ typedef union {
     uint32_t u;
 } sg_bits_t;
 
+#if !SG_HAVE_BUILTINS
+/* |x| by clearing the sign bit: __builtin_fabsf's bits for every x, NaN included. */
+static inline float sg_fabsf_c99(float x)
+{
+    sg_bits_t b;
+    b.f = x;
+    b.u &= 0x7fffffffu;
+    return b.f;
+}
+
+/* Correctly rounded sqrt (round to nearest even) by digit-by-digit root extraction on the
+ * significand: __builtin_sqrtf's bits (VSQRT / sqrtss) for every x; sg_math.c. */
+float sg_sqrtf_c99(float x);
+#endif
+
 /* Interval of |x| from its exponent and top SG_TANH_M mantissa bits; >= SG_TANH_N outside
  * [2^-12, 9), including +-Inf and NaN. */
 static inline uint32_t sg_tanh_index(uint32_t ux)
@@ -113,7 +160,7 @@ static inline float sg_tanh_poly(const float *row, float x, uint32_t ux)
     float t;
     float p;
     SG_LOADS_DONE();
-    t = __builtin_fabsf(x) - c;
+    t = SG_FABSF(x) - c;
     p = c4;
     p = (p * t) + c3;
     p = (p * t) + c2;
@@ -129,7 +176,7 @@ static inline float sg_inline_tanhf(float x)
     float r;
     b.f = x;
     i = sg_tanh_index(b.u);
-    if (__builtin_expect(i >= SG_TANH_N, 0) != 0) {
+    if (SG_EXPECT(i >= SG_TANH_N, 0) != 0) {
         r = sg_tanhf(x);
     } else {
         r = sg_tanh_poly(sg_tanh_tab[i], x, b.u);
@@ -147,7 +194,7 @@ static inline float sg_inline_tanhf_full(float x)
     uint32_t d;
     b.f = x;
     d = (b.u << 1) - SG_TANH_D_FIRST;
-    if (__builtin_expect(d < SG_TANH_D_END, 1) != 0) {
+    if (SG_EXPECT(d < SG_TANH_D_END, 1) != 0) {
         return sg_tanh_poly(sg_tanh_tab[d >> SG_TANH_SHIFT], x, b.u);
     }
     if (d > SG_TANH_D_INF) {
@@ -207,7 +254,7 @@ static SG_ALWAYS_INLINE float sg_powf_fused(float x, float y)
     sg_bits_t bx;
     float result;
     bx.f = x;
-    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+    if (SG_EXPECT((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
         result = sg_powf_pos(x, y); /* not a positive normal finite float */
     } else {
         sg_bits_t by;
@@ -257,7 +304,7 @@ static SG_ALWAYS_INLINE float sg_powf_fused(float x, float y)
         t = th + tl;
         /* |y| <= 31/32 implies |t| <= 124 for every normal x: with such a constant y (the tanh law's)
          * the compiler drops the test on t; the fast-path set is the same either way. */
-        if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < SG_POWF_FUSED_MAX_T), 0) != 0) {
+        if (SG_EXPECT(!(SG_FABSF(y) <= 0x1.fp-1f) && !(SG_FABSF(t) < SG_POWF_FUSED_MAX_T), 0) != 0) {
             result = sg_powf_pos(x, y);
         } else {
             sg_bits_t bt;
@@ -312,7 +359,7 @@ static SG_ALWAYS_INLINE float sg_powf_tab(float x, float y)
     sg_bits_t bx;
     float result;
     bx.f = x;
-    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+    if (SG_EXPECT((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
         result = sg_powf_pos(x, y); /* not a positive normal finite float */
     } else {
         sg_bits_t by;
@@ -356,7 +403,7 @@ static SG_ALWAYS_INLINE float sg_powf_tab(float x, float y)
         t = th + tl;
         /* |y| <= 31/32 implies |t| <= 32 * 124 for every normal x: the test on t folds away for
          * such a constant y; the fast-path set is the same either way. */
-        if (__builtin_expect(!(__builtin_fabsf(y) <= 0x1.fp-1f) && !(__builtin_fabsf(t) < (32.0f * SG_POWF_FUSED_MAX_T)), 0) != 0) {
+        if (SG_EXPECT(!(SG_FABSF(y) <= 0x1.fp-1f) && !(SG_FABSF(t) < (32.0f * SG_POWF_FUSED_MAX_T)), 0) != 0) {
             result = sg_powf_pos(x, y);
         } else {
             sg_bits_t bt;
@@ -405,7 +452,7 @@ static SG_ALWAYS_INLINE float sg_powf_const(float x, const sg_powc_t *t)
     sg_bits_t bx;
     float result;
     bx.f = x;
-    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+    if (SG_EXPECT((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
         if ((t->y > 0.0f) && (bx.u < 0x00800000u)) {
             result = 0.0f; /* +0 or subnormal x, y > 0: +0 (exact at 0, below 2^(-126 y) otherwise) */
         } else {
@@ -456,7 +503,7 @@ static SG_ALWAYS_INLINE float sg_logf_tab(float x)
     sg_bits_t bx;
     float result;
     bx.f = x;
-    if (__builtin_expect((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
+    if (SG_EXPECT((bx.u - 0x00800000u) >= 0x7f000000u, 0) != 0) {
         result = sg_logf(x); /* not a positive normal finite float */
     } else {
         uint32_t ix;

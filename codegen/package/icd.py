@@ -164,6 +164,29 @@ def _code(words) -> str:
     return cell(" ".join(str(w) for w in words))
 
 
+def _reference_words(ev: dict) -> list[str]:
+    """The reference step's expected output words as the evidence records them (hex), if it does."""
+    s = ev.get("selftest_vectors")
+    return [cell(w) for w in s.get("reference_output_words", [])] if isinstance(s, dict) else []
+
+
+def _records(unit: Unit, ev: dict) -> list[tuple[str, int]]:
+    """(C type, sizeof) of each record the evidence measured, in input, output, state order."""
+    sizes = ev.get("memory", {}).get("record_bytes", {})
+    return [(cell(unit.c_types[r]), int(sizes[r])) for r in ROLES if r in sizes and r in unit.c_types]
+
+
+def _selftest_run(evidence: dict, clock: int) -> dict | None:
+    """The self-test's cycles per mode, time and stack in the STM32F417 image's emulator run."""
+    arm = evidence.get("package_build", {}).get("arm", {})
+    cycles = arm.get("selftest_cycles")
+    if not cycles:
+        return None
+    return {"cycles": [(cell(m), c) for m, c in cycles.items()],
+            "ms": {m: f"{c / clock * 1e3:.2f}" for m, c in cycles.items()},
+            "stack": arm.get("selftest_stack_bytes")}
+
+
 def unit_context(name: str, kind: str, unit: Unit, ev: dict, clock: int, budget: int) -> dict:
     modes = _modes(ev["cycles"]["step"])
     return {
@@ -176,7 +199,8 @@ def unit_context(name: str, kind: str, unit: Unit, ev: dict, clock: int, budget:
         "functions": _functions(ev, modes),
         "reference": [(cell(m), c) for m, c in ev["cycles"].get("reference", {}).items()],
         "is_reference_unit": unit.entry == name, "memory": ev["memory"], "gate": _gate(ev),
-        "selftest": _selftest(ev), "envelope": _envelope(unit),
+        "selftest": _selftest(ev), "envelope": _envelope(unit), "integrity": unit.integrity_symbol,
+        "reference_words": _reference_words(ev), "records": _records(unit, ev),
     }
 
 
@@ -185,7 +209,7 @@ def render_icd(name: str, units: dict[str, Unit], config: dict, evidence: dict, 
     configuration `config` (the configuration file's mapping, plus "inputs": {role: {"file",
     "sha256"}}), `evidence` as tools/package.py measures it ({"units": {kind: {...}}, "clock_hz",
     "paper_budget_cycles", optionally "package_build"}), `flags` {"common", "arm_cpu",
-    "compiler", optionally "signed": whether the manifest is signed}. The same arguments give the same bytes."""
+    "compiler", optionally "signed": whether the manifest is signed, "gcc_only"}. The same arguments give the same bytes."""
     check_name(name)
     clock = int(evidence.get("clock_hz", 168_000_000))
     budget = int(evidence.get("paper_budget_cycles", 554_400))
@@ -203,5 +227,6 @@ def render_icd(name: str, units: dict[str, Unit], config: dict, evidence: dict, 
         "clock_mhz": f"{clock / 1e6:g}", "budget": budget, "budget_ms": f"{budget / clock * 1e3:g}",
         "package_build": [(cell(t), r.get("selftest_mismatches")) for t, r in evidence.get("package_build", {}).items()],
         "signed": bool(flags.get("signed", False)),
+        "selftest_run": _selftest_run(evidence, clock), "gcc_only": _code(flags.get("gcc_only", [])),
     }
     return environment(TEMPLATES).get_template("ICD.md.j2").render(ctx)

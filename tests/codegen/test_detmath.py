@@ -411,6 +411,25 @@ def test_arm_emulated_equals_twin(tmp_path):
         assert not bad.any(), (name, p[bad][:5], q[bad][:5])
 
 
+def test_arm_sqrt_fallback_equals_vsqrt(tmp_path):
+    """sg_sqrtf built with -DSG_NO_BUILTINS (the C99 integer root, issue 25) gives VSQRT's bits on
+    the Cortex-M4F, NaNs included (its default NaN and quieted payloads are the FPU's own)."""
+    (tmp_path / "builtin").mkdir()
+    (tmp_path / "c99").mkdir()
+    vsqrt = _arm_runner(tmp_path / "builtin")
+    c99 = _arm_runner(tmp_path / "c99", ["-DSG_NO_BUILTINS"])
+    rng = np.random.default_rng(25)
+    near = (SPECIALS.view(np.uint32).astype(np.int64)[:, None] + np.arange(-3, 4)).ravel() % 2**32
+    x = np.concatenate([near.astype(np.uint32), rng.integers(0, 2**32, 3_000, dtype=np.uint64).astype(np.uint32),
+                        rng.integers(0x3F800000, 0x40800000, 1_000, dtype=np.uint64).astype(np.uint32)])
+    nm = subprocess.run(["arm-none-eabi-nm", str(tmp_path / "c99" / "sg_math.elf")], capture_output=True, text=True,
+                        check=True).stdout
+    assert " sg_sqrtf_c99" in nm                     # the fallback is what runs
+    want, got = vsqrt("sqrtf", x), c99("sqrtf", x)
+    bad = want.view(np.uint32) != got.view(np.uint32)
+    assert not bad.any(), [hex(v) for v in x[bad][:5]]
+
+
 # ---------------------------------------------------------------- sg_powf_fused (sg_math.h)
 
 def powf_fused_inputs(rng: np.random.Generator, n: int = 120_000) -> tuple[np.ndarray, np.ndarray]:

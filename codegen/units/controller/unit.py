@@ -17,8 +17,10 @@ from codegen.units.controller import spec as cs
 from codegen.units.controller.emit import (DEFAULT_NAME, INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, controller_sources,
                                            net_name)
 
-# SPEC section 8 budgets of the whole step as this generator meets them (ideal memory).
-BUDGETS = Budgets(cycles=5_000, cycles_art=5_500, flash=24 * 1024, ram=16 * 1024, stack=512)
+# SPEC section 8 budgets of the whole step as this generator meets them (ideal memory). No art
+# budget: the step runs its code once per call, so its art figure is ideal + 5 cycles per flash
+# line it touches (SPEC 7), reported with that count, not judged.
+BUDGETS = Budgets(cycles=5_000, cycles_art=None, flash=24 * 1024, ram=16 * 1024, stack=512)
 
 
 class ControllerUnit(Unit):
@@ -31,6 +33,10 @@ class ControllerUnit(Unit):
         self.artifact, self.config, self.scenario = artifact, config, scenario
         self._sources = controller_sources(artifact, config, name)
         super().__init__(name, INPUT_DTYPE, OUTPUT_DTYPE, STATE_DTYPE, BUDGETS)
+
+    @property
+    def integrity_symbol(self) -> str:
+        return f"{self.entry}_integrity_check"
 
     def identity(self) -> str:
         mode = ", PID only" if self.config.pid_only else ""

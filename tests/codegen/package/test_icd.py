@@ -6,6 +6,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import re
+import subprocess
 
 import numpy as np
 import pytest
@@ -340,3 +341,87 @@ def test_input_file_names_are_escaped_for_markdown_and_html():
     (row,) = [ln for ln in text.splitlines() if ln.startswith("| network |")]
     assert "<img" not in text and not re.search(r"(?<!\\)\]\(javascript:", text)   # no raw tag, no link
     assert split_row(row)[1] == "&lt;img src=x onerror=alert(1)&gt;\\[a\\](javascript:x)\\_\\*.json"
+# ----------------------------------------------------------------------------- issue 25, defect 21
+
+def evidence_with_runs(pkg: dict) -> dict:
+    """evidence_for plus what tools/package.py measures since issue 25: the reference step's
+    output words, the record sizes, the self-test's cycles and stack in the ARM image."""
+    ev = evidence_for(pkg)
+    for kind, unit in pkg.items():
+        e = ev["units"][kind]
+        e["selftest_vectors"] = {"n": 256, "classes": {}, "targets": {},
+                                 "reference_output_words": [f"0x{0x3f800000 + 17 * i + len(kind):08x}"
+                                                            for i in range(unit.output_dtype.itemsize // 4)]}
+        e["memory"]["record_bytes"] = {r: getattr(unit, f"{r}_dtype").itemsize for r in ROLES
+                                       if getattr(unit, f"{r}_dtype") is not None}
+        e["memory"]["tables_in"] = unit.tables_in
+    ev["package_build"] = {"x86": {"selftest_mismatches": 0},
+                           "arm": {"selftest_mismatches": 0, "reference_cycles": {},
+                                   "selftest_cycles": {"ideal": 912_345, "art": 1_391_234, "pessimistic": 2_015_678},
+                                   "selftest_stack_bytes": 396}}
+    return ev
+
+
+def test_integrity_check_is_in_the_call_sequence_and_the_example():
+    pkg = bound_units()
+    header = pkg["controller"].sources()["stare.h"]
+    m = re.search(r"uint32_t (\w+_integrity_check)\((\w+) \*state\);", header)   # what the C declares
+    assert m and m.group(2) == "stare_state_t"
+    text = render(pkg=pkg, evidence=evidence_with_runs(pkg))
+    calls = section(text, "## Call sequence")
+    assert f"`{m.group(1)}(&stare_state)`" in calls
+    example = text[text.index("```c"):]
+    assert example.index("stare_init(") < example.index(f"{m.group(1)}(&stare_state)")
+    assert example.count(f"{m.group(1)}(&stare_state)") == 2          # at start-up and in a background tick
+    ccm = section(unit_section(text, "controller"), "### Memory")
+    assert f"`{m.group(1)}()`" in ccm and "tables_crc32()` against" not in ccm
+
+
+def test_the_public_header_reaches_the_tables_crc(tmp_path):
+    """stare.h, the header the firmware includes, declares (by including the network's header) the
+    CRC function and value that stare_integrity_check compares."""
+    for name, text in bound_units(with_tanh=False)["controller"].sources().items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "user.c").write_text('#include "stare.h"\n'
+                                     "int tables_intact(void);\n"
+                                     "int tables_intact(void) { return stare_nn_tables_crc32() == STARE_NN_TABLES_CRC32; }\n")
+    res = subprocess.run(["gcc", *COMMON, "-I", str(tmp_path), "-c", str(tmp_path / "user.c"), "-o",
+                          str(tmp_path / "user.o")], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+
+
+def test_reference_words_selftest_run_and_record_sizes_are_stated():
+    pkg = bound_units()
+    ev = evidence_with_runs(pkg)
+    text = render(pkg=pkg, evidence=ev)
+    for kind, unit in pkg.items():
+        part = unit_section(text, kind)
+        words = ev["units"][kind]["selftest_vectors"]["reference_output_words"]
+        assert f"`{' '.join(words)}`" in section(part, "### Timing on the STM32F417 (cycle model, 168 MHz)")
+        memory = section(part, "### Memory")
+        for role, n in ev["units"][kind]["memory"]["record_bytes"].items():
+            assert f"`sizeof({unit.entry}_{role}_t)` = {n} B" in memory, (kind, role)
+    selftest = section(text, "## Self-test")
+    arm = ev["package_build"]["arm"]
+    for mode, cycles in arm["selftest_cycles"].items():
+        assert f"{cycles} cycles {mode} ({cycles / CLOCK * 1e3:.2f} ms)" in selftest
+    assert f"uses {arm['selftest_stack_bytes']} B of stack" in selftest
+
+
+def test_ccm_rule_moves_the_package_tables_only():
+    pkg = bound_units()
+    text = render(pkg=pkg, evidence=evidence_with_runs(pkg))
+    memory = section(unit_section(text, "controller"), "### Memory")
+    assert "*(.sg_tables .sg_tables.*)" in memory and "> CCM AT > FLASH" in memory
+    assert ".rodata" not in memory                       # not every read-only section of the firmware
+    # the generated C puts its tables there (GCC / clang only)
+    sources = bound_units(with_tanh=False)["controller"].sources()
+    assert "#define SG_TABLE(section_name) __attribute__((section(section_name)))" in sources["sg_math.h"]
+    assert re.search(r'static const float stare_nn_neurons\[.*\] SG_TABLE\("\.sg_tables\.stare_nn_neurons"\) =',
+                     sources["stare_nn.c"])
+
+
+def test_compilers_and_math_errno_are_stated():
+    build = section(render(), "## Build requirements and floating-point environment")
+    for needed in ("clang", "armclang", "IAR", "--target=thumbv7em-none-eabihf", "-fno-math-errno", "`ARMClang`"):
+        assert needed in build, needed

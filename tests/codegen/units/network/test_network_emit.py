@@ -75,7 +75,7 @@ def test_constants_are_exact_and_in_consumption_order(artifact, sources):
     want = np.concatenate([np.concatenate([[f.b1[j]], f.W1[j], f.W2[:, j]])
                            for j in range(artifact.n_hidden)]).astype(np.float64)
     np.testing.assert_array_equal(got, want)
-    b2 = c[c.index("network_b2[NETWORK_N_OUT] ="):].split(";")[0]
+    b2 = c[c.index("network_b2[NETWORK_N_OUT] SG_TABLE("):].split(";")[0]
     np.testing.assert_array_equal(np.array(hex_literals(b2)), f.b2.astype(np.float64))
     # this artifact's training ranges are symmetric (or [-1.2, 0]): every input is raw, no offset table
     assert f.centred_inputs == [] and "network_in_xoffset[" not in c
@@ -187,6 +187,22 @@ def arm_compile(src_dir, out, *extra):
     res = subprocess.run(cmd, capture_output=True, text=True)
     assert res.returncode == 0, res.stderr
     return out
+
+
+CLANG_TARGETS = {"x86": [], "arm": [f"--target={flags.CLANG_ARM_TARGET}", *flags.ARM_CPU]}
+
+
+@pytest.mark.parametrize("target", sorted(CLANG_TARGETS))
+@pytest.mark.parametrize("n_hidden", [40, 41])   # the two-neuron loop and the one-neuron loop
+def test_both_loop_shapes_build_with_clang_under_werror(tmp_path, n_hidden, target):
+    """clang's -Wunused-function (with -Werror) refuses a static the loop does not call: each
+    loop shape's tanh helpers are emitted only where used (issue 25, defect 17)."""
+    assert shutil.which("clang"), "clang missing: run tools/setup.sh"
+    write_sources(emit.network_sources(art.random_artifact((12, n_hidden, 3), seed=4)), tmp_path)
+    res = subprocess.run(["clang", *flags.PORTABLE, *CLANG_TARGETS[target], "-I", str(tmp_path), "-c",
+                          str(tmp_path / "network.c"), "-o", str(tmp_path / "network.o")], capture_output=True,
+                         text=True)
+    assert res.returncode == 0, res.stderr
 
 
 def test_arm_build_is_clean_and_the_mlp_loop_does_not_spill(artifact, tmp_path):

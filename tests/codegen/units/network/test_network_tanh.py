@@ -77,24 +77,15 @@ def test_signed_rows_give_sg_tanhf_for_every_argument_in_the_table():
     _check_range(LO, HI)
 
 
-WRAPPERS = """
+# Each loop shape emits only the tanh helpers it calls (clang's -Wunused-function): the one-neuron
+# helper network_tanh with an odd hidden count (41), the pair helper with an even one (40).
+WRAPPERS = {41: """
 void test_tanh(const float *x, float *y, int n)
 {
     network_rows_t mid = &network_tanh_rows[NETWORK_TANH_HALF];
     int i;
     for (i = 0; i < n; i++) {
         y[i] = network_tanh(mid, x[i]);
-    }
-}
-
-void test_tanh_pair(const float *a, const float *b, float *ya, float *yb, int n)
-{
-    network_rows_t mid = &network_tanh_rows[NETWORK_TANH_HALF];
-    int i;
-    for (i = 0; i < n; i++) {
-        const network_pair_t r = network_tanh_pair(mid, a[i], b[i]);
-        ya[i] = r.a;
-        yb[i] = r.b;
     }
 }
 
@@ -105,42 +96,55 @@ void test_sg_tanhf(const float *x, float *y, int n)
         y[i] = sg_tanhf(x[i]);
     }
 }
-"""
+""", 40: """
+void test_tanh_pair(const float *a, const float *b, float *ya, float *yb, int n)
+{
+    network_rows_t mid = &network_tanh_rows[NETWORK_TANH_HALF];
+    int i;
+    for (i = 0; i < n; i++) {
+        const network_pair_t r = network_tanh_pair(mid, a[i], b[i]);
+        ya[i] = r.a;
+        yb[i] = r.b;
+    }
+}
+"""}
+CDEFS = {41: "void test_tanh(const float *, float *, int); void test_sg_tanhf(const float *, float *, int);",
+         40: "void test_tanh_pair(const float *, const float *, float *, float *, int);"}
 
 
-@pytest.fixture(scope="module")
-def clib(tmp_path_factory):
-    """network.c (with test wrappers appended: its helpers are static) + sg_math.c, x86, flight flags."""
-    d = tmp_path_factory.mktemp("network_tanh")
-    sources = emit.network_sources(art.random_artifact((12, 40, 3), seed=1))
-    sources["network.c"] += WRAPPERS
+def _network_lib(d, n_hidden: int):
+    """network.c of a 12-n_hidden-3 network (with test wrappers appended: its helpers are static) +
+    sg_math.c, x86, flight flags."""
+    sources = emit.network_sources(art.random_artifact((12, n_hidden, 3), seed=1))
+    sources["network.c"] += WRAPPERS[n_hidden]
     for name, text in sources.items():
         (d / name).write_text(text)
     so = d / "libnet.so"
     subprocess.run(["gcc", *COMMON, "-Wno-missing-prototypes", "-fPIC", "-shared", "-I", str(d),
                     str(d / "network.c"), str(d / "sg_math.c"), "-o", str(so)], check=True)
     ffi = cffi.FFI()
-    ffi.cdef("void test_tanh(const float *, float *, int);"
-             "void test_tanh_pair(const float *, const float *, float *, float *, int);"
-             "void test_sg_tanhf(const float *, float *, int);")
-    lib = ffi.dlopen(str(so))
+    ffi.cdef(CDEFS[n_hidden])
+    return ffi, ffi.dlopen(str(so))
 
-    def ptr(a):
-        return ffi.from_buffer("float[]", a)
+
+@pytest.fixture(scope="module")
+def clib(tmp_path_factory):
+    """The one-neuron helper, the pair helper and sg_tanhf, as numpy functions."""
+    (ffi1, one), (ffi2, two) = (_network_lib(tmp_path_factory.mktemp(f"network_tanh{n}"), n) for n in (41, 40))
 
     def tanh(x):
         y = np.empty_like(x)
-        lib.test_tanh(ptr(x), ptr(y), x.size)
+        one.test_tanh(ffi1.from_buffer("float[]", x), ffi1.from_buffer("float[]", y), x.size)
         return y
 
     def pair(a, b):
         ya, yb = np.empty_like(a), np.empty_like(b)
-        lib.test_tanh_pair(ptr(a), ptr(b), ptr(ya), ptr(yb), a.size)
+        two.test_tanh_pair(*(ffi2.from_buffer("float[]", v) for v in (a, b, ya, yb)), a.size)
         return ya, yb
 
     def sg(x):
         y = np.empty_like(x)
-        lib.test_sg_tanhf(ptr(x), ptr(y), x.size)
+        one.test_sg_tanhf(ffi1.from_buffer("float[]", x), ffi1.from_buffer("float[]", y), x.size)
         return y
 
     return tanh, pair, sg
