@@ -30,7 +30,7 @@ def read_bytes(path: str | os.PathLike, cap: int = MAX_FILE_BYTES) -> bytes:
         # O_NONBLOCK: opening a FIFO must not wait for a writer before fstat can refuse it
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except FileNotFoundError:
-        raise InputFileError(f"{path}: no such file") from None
+        raise InputFileError(f"{path}: cannot read (no such file)") from None
     except OSError as exc:
         raise InputFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if not stat.S_ISREG(os.fstat(fd).st_mode):

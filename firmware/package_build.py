@@ -14,13 +14,13 @@ import subprocess
 from pathlib import Path
 from typing import Sequence
 
+from codegen.names import name_problem, show
 from firmware.errors import FirmwareError
 
 HERE = Path(__file__).resolve().parent
 IMAGE_PROJECT = HERE / "package_image"
 TOOLCHAIN = IMAGE_PROJECT / "toolchain-arm-none-eabi.cmake"
 TARGETS = ("arm", "x86")
-_NAME = re.compile(r"[a-z][a-z0-9_]{0,30}")
 _FLAG = re.compile(r"-[A-Za-z0-9_=+.,-]+")
 
 
@@ -53,8 +53,9 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
     executable (x86). `c_flags` are appended to the project's CMAKE_C_FLAGS (a test passes a fast-math flag to see the guard)."""
     if target not in TARGETS:
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
-    if not _NAME.fullmatch(name):
-        raise FirmwareError(f"package build: {name!r} is not a package name")
+    problem = name_problem(name)
+    if problem:
+        raise FirmwareError(f"package build: package name {show(name)}: {problem}")
     for f in c_flags:
         if not _FLAG.fullmatch(f):
             raise FirmwareError(f"package build: {f!r} is not a plain compiler option")
