@@ -69,14 +69,14 @@ def float32_in(value, key: str, low: float | None = None, high: float | None = N
     x = real(value, key, error)
     f = np.float32(x)
     if x != 0.0 and not abs(float(f)) >= FLOAT32_TINY:
-        raise error(f"{key}: {x:g} rounds to {'0' if f == 0 else 'a subnormal'} in float32 (the generated C "
+        raise error(f"{key}: {x!r} rounds to {'0' if f == 0 else 'a subnormal'} in float32 (the generated C "
                     f"holds float32; nonzero values need magnitude >= {FLOAT32_TINY:.4g})")
     y = float(f)
     below = low is not None and (y < low or (low_open and y == low))
     above = high is not None and (y > high or (high_open and y == high))
     if below or above:
         rounded = "" if y == x else f" (as float32: {y!r})"
-        raise error(f"{key}: must be {_bound_text(low, high, low_open, high_open)}, got {x:g}{rounded}")
+        raise error(f"{key}: must be {_bound_text(low, high, low_open, high_open)}, got {x!r}{rounded}")
     return f
 
 
