@@ -11,6 +11,8 @@ import pytest
 from codegen import names, reading
 from codegen.cgen import check_name
 from codegen.package import config as pc
+from firmware.errors import FirmwareError
+from firmware.package_build import build_image
 from host.control.nn_controller import CONFIG_SOURCES, default_package_config
 
 
@@ -182,7 +184,7 @@ def test_reads_are_capped_by_the_bytes_read(default_file):
         pc.load(default_file)
 
 
-def test_every_name_config_accepts_generates_valid_entries():
+def test_every_name_config_accepts_generates_valid_entries(tmp_path):
     """Whatever the configuration accepts, every emitter and the package build accept too."""
     for name in ("a", "stare", "sgp", "x_nn", "abcdefghijkl", "image2", "s", "tanh", "nn"):
         cfg = default_package_config(name)
@@ -192,3 +194,5 @@ def test_every_name_config_accepts_generates_valid_entries():
     for name in ("sg", "sg_x", "image", "int", "stdint", "all", "abcdefghijklm", "1a", "A"):
         with pytest.raises(pc.ConfigError):
             default_package_config(name)
+        with pytest.raises(FirmwareError, match="package name"):     # the test image's build: the same rule
+            build_image(tmp_path, name, "x86", tmp_path / "build")
