@@ -103,7 +103,8 @@ def test_the_checks_fail_on_a_planted_upward_import_and_a_planted_cycle():
     assert upward_imports(graph(planted)) == ["codegen.artifact -> host.cli"]
     planted = dict(sources)
     planted["codegen.errors"] = sources["codegen.errors"] + "\nfrom codegen import artifact\n"
-    assert ["codegen.artifact", "codegen.errors"] in cycles(graph(planted))
+    # the planted cycle's component holds both (and whatever else lies on a path between them)
+    assert any({"codegen.artifact", "codegen.errors"} <= set(c) for c in cycles(graph(planted)))
 
 
 def test_the_top_level_stays_that_of_the_readme():
