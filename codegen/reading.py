@@ -22,6 +22,10 @@ class InputFileError(CodegenError):
     """An input file that cannot be read: missing, not a regular file, too large, not UTF-8."""
 
 
+class FileTooLargeError(InputFileError):
+    """An input file longer than the reader's cap."""
+
+
 def read_bytes(path: str | os.PathLike, cap: int = MAX_FILE_BYTES) -> bytes:
     """The bytes of the regular file at `path`, at most `cap` of them, or a one-line InputFileError
     naming the file (also for OSError: a missing file, a folder, no permission)."""
@@ -35,14 +39,14 @@ def read_bytes(path: str | os.PathLike, cap: int = MAX_FILE_BYTES) -> bytes:
         raise InputFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if not stat.S_ISREG(os.fstat(fd).st_mode):
         os.close(fd)
-        raise InputFileError(f"{path}: not a regular file")
+        raise InputFileError(f"{path}: cannot read (not a regular file)")
     with os.fdopen(fd, "rb") as fh:
         try:
             data = fh.read(cap + 1)
         except OSError as exc:
             raise InputFileError(f"{path}: cannot read ({exc.strerror or exc})") from None
     if len(data) > cap:
-        raise InputFileError(f"{path}: larger than {cap} bytes")
+        raise FileTooLargeError(f"{path}: larger than {cap} bytes")
     return data
 
 

@@ -157,7 +157,7 @@ def load_params(path: str | Path) -> TanhParams:
     try:
         text = reading.read_text(path)
     except reading.InputFileError as exc:
-        raise TanhParamsError(f"{exc} (parameter file)") from None
+        raise TanhParamsError(str(exc)) from None
     try:
         data = tomllib.loads(text) if path.suffix == ".toml" else reading.parse_json(text)
     except (ValueError, RecursionError) as exc:   # syntax, duplicate keys, NaN, integers of > 4300 digits

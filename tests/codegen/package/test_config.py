@@ -157,7 +157,7 @@ def _error_of(read, path) -> str:
 
 def test_a_folder_is_not_read(tmp_path):
     for read in (pc.load, pc.seal):
-        assert _error_of(read, tmp_path) == f"{tmp_path}: not a regular file"
+        assert _error_of(read, tmp_path) == f"{tmp_path}: cannot read (not a regular file)"
 
 
 def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
@@ -174,7 +174,7 @@ def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
         if worker.is_alive():
             os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))   # the reader gets EOF
             worker.join(5.0)
-        assert result.get("error") == f"{path}: not a regular file"
+        assert result.get("error") == f"{path}: cannot read (not a regular file)"
 
 
 def test_reads_are_capped_by_the_bytes_read(default_file):

@@ -113,7 +113,7 @@ def test_a_fifo_is_refused_without_waiting_for_a_writer(tmp_path):
     if worker.is_alive():
         os.close(os.open(path, os.O_WRONLY | os.O_NONBLOCK))   # release a blocked reader: EOF
         worker.join(5.0)
-    assert result.get("error", "").startswith(f"{path}: not a regular file")
+    assert result.get("error", "").startswith(f"{path}: cannot read (not a regular file)")
 
 
 def test_a_file_without_the_suffix_is_refused_before_it_is_read():
