@@ -23,6 +23,7 @@ import numpy as np
 
 from codegen.errors import CodegenError
 from codegen import atomic, reading
+from codegen.values import DIGITS_TEXT
 
 FORMAT = "staregen.mlp-artifact"
 VERSION = 1
@@ -578,7 +579,7 @@ def _tensor64(t) -> np.ndarray:
 def parse_shape(text: str) -> tuple[int, int, int]:
     """'12-40-3' -> (12, 40, 3), refused before anything is allocated when no artifact may hold it."""
     parts = text.split("-")
-    if len(parts) != 3 or not all(DIGITS.fullmatch(p) and len(p) <= 6 and 0 < int(p) <= MAX_LAYER_SIZE for p in parts):
+    if len(parts) != 3 or not all(DIGITS_TEXT.fullmatch(p) and len(p) <= 6 and 0 < int(p) <= MAX_LAYER_SIZE for p in parts):
         raise CodegenError(f"--shape: expected N_IN-N_HIDDEN-N_OUT with integers in [1, {MAX_LAYER_SIZE}] "
                            f"(e.g. 12-40-3), got {text[:40]!r}")
     shape = tuple(int(p) for p in parts)
@@ -591,7 +592,6 @@ def parse_shape(text: str) -> tuple[int, int, int]:
 # Bigger layers cannot be flight code on the STM32F417 (12-10000-3 is 640 KB of weights of 1 MB flash).
 MAX_LAYER_SIZE = 10_000
 MAX_PARAMETERS = (1 << 20) // 4     # float32 weights and biases that fit the STM32F417's 1 MB of flash
-DIGITS = re.compile(r"[0-9]+")      # ASCII only (str.isdigit also takes other scripts' digits)
 
 
 def n_parameters(shape: Sequence[int]) -> int:

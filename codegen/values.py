@@ -25,6 +25,7 @@ FLOAT32_TINY = float(np.finfo(np.float32).tiny)     # smallest normal float32, 2
 
 DECIMAL_TEXT = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 INTEGER_TEXT = re.compile(r"[+-]?[0-9]+")
+DIGITS_TEXT = re.compile(r"[0-9]+")       # str.isdigit() and int() also take other scripts' digits
 
 
 def show(value, n: int = 40) -> str:
