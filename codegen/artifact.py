@@ -591,7 +591,9 @@ def parse_shape(text: str) -> tuple[int, int, int]:
 
 # Bigger layers cannot be flight code on the STM32F417 (12-10000-3 is 640 KB of weights of 1 MB flash).
 MAX_LAYER_SIZE = 10_000
-MAX_PARAMETERS = (1 << 20) // 4     # float32 weights and biases that fit the STM32F417's 1 MB of flash
+# What an artifact may hold: at about 16 bytes per value as written (a float32 hex float, its quotes
+# and separator), a MAX_FILE_BYTES file holds about 4.2 million weights and biases.
+MAX_PARAMETERS = reading.MAX_FILE_BYTES // 16
 
 
 def n_parameters(shape: Sequence[int]) -> int:
@@ -601,11 +603,9 @@ def n_parameters(shape: Sequence[int]) -> int:
 
 def shape_problem(shape: Sequence[int]) -> str | None:
     """None, or why no artifact may hold a network of this (n_in, n_hidden, n_out)."""
-    if any(not 1 <= s <= MAX_LAYER_SIZE for s in shape):
-        return f"every size must be in [1, {MAX_LAYER_SIZE}]"
     if n_parameters(shape) > MAX_PARAMETERS:
         return (f"{n_parameters(shape):,} weights and biases, more than the {MAX_PARAMETERS:,} "
-                "(1 MB of float32 flash) an artifact may hold")
+                f"an artifact may hold (its file is at most {MAX_FILE_BYTES >> 20} MiB)")
     return None
 
 

@@ -63,7 +63,7 @@ def _bound_text(low, high, low_open: bool, high_open: bool) -> str:
 
 
 def float32_in(value, key: str, low: float | None = None, high: float | None = None, *,
-               low_open: bool = False, high_open: bool = False,
+               low_open: bool = False, high_open: bool = False, unit: str = "",
                error: type[CodegenError] = CodegenError) -> np.float32:
     """The float32 the C will hold for a parsed number, checked against [low, high] (ends open as
     told) after rounding; a nonzero value that rounds to 0 or a subnormal is refused."""
@@ -77,7 +77,8 @@ def float32_in(value, key: str, low: float | None = None, high: float | None = N
     above = high is not None and (y > high or (high_open and y == high))
     if below or above:
         rounded = "" if y == x else f" (as float32: {y!r})"
-        raise error(f"{key}: must be {_bound_text(low, high, low_open, high_open)}, got {x!r}{rounded}")
+        unit_text = f" {unit}" if unit else ""
+        raise error(f"{key}: must be {_bound_text(low, high, low_open, high_open)}{unit_text}, got {x!r}{rounded}")
     return f
 
 

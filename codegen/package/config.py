@@ -119,7 +119,7 @@ def _value(kind: str, v, key: str):
     if kind == ">0":
         return _real(v, key, 0.0, low_open=True)
     if kind == "period":
-        return _real(v, key, 0.0, MAX_PERIOD_S, low_open=True)
+        return _real(v, key, 0.0, MAX_PERIOD_S, low_open=True, unit="s")
     if kind == "[0,1)":
         return _real(v, key, 0.0, 1.0, high_open=True)
     raise ValueError(f"{key}: unknown schema kind {kind!r}")

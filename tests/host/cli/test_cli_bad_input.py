@@ -190,7 +190,7 @@ CASES = [
     (["artifact", "check", "/dev/zero"], "/dev/zero: file: cannot read (not a regular file)"),
     (["generate", "--config", "{cfg}", "--network", "{net}", "--tanh", "{tmp}/p25/zero.toml", "--out", "{tmp}/pkg"],
      "zero.toml: cannot read (not a regular file)"),
-    (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "an artifact may hold"),
+    (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "more than the 4,194,304 an artifact may hold"),
     (["tanh", "gate", "--params", "{tmp}/p25/eps1.toml"], "'eps1': 1e-50 rounds to 0 in float32"),
     (["tanh", "gate", "--params", "{tmp}/p25/eta.toml"], "'eta': 1e-300 rounds to 0 in float32"),
     (["tanh", "gate", "--params", "{tmp}/p25/gamma.json"], "'gamma': 1e-300 rounds to 0 in float32"),
