@@ -22,7 +22,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from codegen.errors import CodegenError
-from codegen import atomic
+from codegen import atomic, reading
+from codegen.values import DIGITS_TEXT
 
 FORMAT = "staregen.mlp-artifact"
 VERSION = 1
@@ -576,16 +577,36 @@ def _tensor64(t) -> np.ndarray:
 
 
 def parse_shape(text: str) -> tuple[int, int, int]:
-    """'12-40-3' -> (12, 40, 3)."""
+    """'12-40-3' -> (12, 40, 3), refused before anything is allocated when no artifact may hold it."""
     parts = text.split("-")
-    if len(parts) != 3 or not all(p.isdigit() and len(p) <= 6 and 0 < int(p) <= MAX_LAYER_SIZE for p in parts):
+    if len(parts) != 3 or not all(DIGITS_TEXT.fullmatch(p) and len(p) <= 6 and 0 < int(p) <= MAX_LAYER_SIZE for p in parts):
         raise CodegenError(f"--shape: expected N_IN-N_HIDDEN-N_OUT with integers in [1, {MAX_LAYER_SIZE}] "
                            f"(e.g. 12-40-3), got {text[:40]!r}")
-    return tuple(int(p) for p in parts)  # type: ignore[return-value]
+    shape = tuple(int(p) for p in parts)
+    problem = shape_problem(shape)
+    if problem:
+        raise CodegenError(f"--shape: {text}: {problem}")
+    return shape  # type: ignore[return-value]
 
 
 # Bigger layers cannot be flight code on the STM32F417 (12-10000-3 is 640 KB of weights of 1 MB flash).
 MAX_LAYER_SIZE = 10_000
+# What an artifact may hold: at about 16 bytes per value as written (a float32 hex float, its quotes
+# and separator), a MAX_FILE_BYTES file holds about 4.2 million weights and biases.
+MAX_PARAMETERS = reading.MAX_FILE_BYTES // 16
+
+
+def n_parameters(shape: Sequence[int]) -> int:
+    n_in, n_hidden, n_out = shape
+    return n_hidden * (n_in + 1) + n_out * (n_hidden + 1)
+
+
+def shape_problem(shape: Sequence[int]) -> str | None:
+    """None, or why no artifact may hold a network of this (n_in, n_hidden, n_out)."""
+    if n_parameters(shape) > MAX_PARAMETERS:
+        return (f"{n_parameters(shape):,} weights and biases, more than the {MAX_PARAMETERS:,} "
+                f"an artifact may hold (its file is at most {MAX_FILE_BYTES >> 20} MiB)")
+    return None
 
 
 def random_artifact(shape: Sequence[int] = (12, 40, 3), seed: int = 0) -> Artifact:
@@ -595,6 +616,9 @@ def random_artifact(shape: Sequence[int] = (12, 40, 3), seed: int = 0) -> Artifa
     Weights are large enough that hidden pre-activations reach tanh saturation.
     """
     n_in, n_hidden, n_out = (int(s) for s in shape)
+    problem = shape_problem((n_in, n_hidden, n_out))
+    if problem:     # before allocating the weights
+        raise CodegenError(f"shape {n_in}-{n_hidden}-{n_out}: {problem}")
     rng = np.random.default_rng(seed)
     W1 = rng.uniform(-1.0, 1.0, (n_hidden, n_in))
     b1 = rng.uniform(-1.0, 1.0, n_hidden)
@@ -686,7 +710,10 @@ def _read_sizes(r: _Reader, network: dict) -> tuple[int, int, int]:
         r.fail(f"{NETWORK}.sizes", f"expected 3 sizes [n_in, n_hidden, n_out], got {len(sizes)}")
     for i, s in enumerate(sizes):
         if isinstance(s, bool) or not isinstance(s, int) or s < 1:
-            r.fail(f"{NETWORK}.sizes[{i}]", f"expected a positive integer, got {s!r}")
+            r.fail(f"{NETWORK}.sizes[{i}]", f"expected a positive integer, got {_clip(repr(s))}")
+    problem = shape_problem(sizes)
+    if problem:
+        r.fail(f"{NETWORK}.sizes", problem)
     acts = r.strings(network["activations"], f"{NETWORK}.activations", 2)
     if acts != ACTIVATIONS:
         r.fail(f"{NETWORK}.activations", f"expected {list(ACTIVATIONS)}, got {list(acts)}")
@@ -787,15 +814,13 @@ def _check_seal(r: _Reader, doc: dict) -> None:
 
 
 def read_document(path: str | os.PathLike):
-    """A sealed JSON file's document (any artifact format): size-capped, UTF-8, strict JSON."""
-    path = Path(path)
+    """A sealed JSON file's document (any artifact format): size-capped by the bytes read, a
+    regular file, UTF-8, strict JSON."""
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise ArtifactError("file", f"larger than {MAX_FILE_BYTES} bytes", str(path))
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ArtifactError("file", "no such file", str(path)) from None
-    except (OSError, UnicodeDecodeError) as exc:
+        text = reading.read_bytes(path, MAX_FILE_BYTES).decode("utf-8")
+    except reading.InputFileError as exc:
+        raise ArtifactError("file", str(exc).removeprefix(f"{path}: "), str(path)) from None
+    except UnicodeDecodeError as exc:
         raise ArtifactError("file", f"cannot read: {exc}", str(path)) from None
     return parse_json(text, str(path))
 
@@ -805,45 +830,17 @@ def load(path: str | os.PathLike) -> Artifact:
     return from_document(read_document(path), str(path))
 
 
-MAX_FILE_BYTES = 64 << 20
-MAX_DEPTH = 32
+MAX_FILE_BYTES = reading.MAX_FILE_BYTES
+MAX_DEPTH = reading.MAX_JSON_DEPTH
 
 
 def parse_json(text: str, source: str | None = None):
     """Strict JSON: no NaN/Infinity constants, no duplicate keys, at most MAX_DEPTH levels of nesting."""
-    depth = current = 0
-    in_string = escaped = False
-    for ch in text:   # nesting depth, counted before the recursive parser sees it
-        if in_string:
-            escaped = not escaped and ch == "\\"
-            in_string = escaped or ch != '"'
-        elif ch == '"':
-            in_string = True
-        elif ch in "[{":
-            current += 1
-            depth = max(depth, current)
-        elif ch in "]}":
-            current -= 1
-    if depth > MAX_DEPTH:
-        raise ArtifactError("file", f"not valid JSON: nested deeper than {MAX_DEPTH} levels", source)
     try:
-        return json.loads(text, parse_constant=_reject_constant, object_pairs_hook=_unique_keys)
-    except (ValueError, RecursionError) as exc:
+        return reading.parse_json(text)
+    except ValueError as exc:
         raise ArtifactError("file", f"not valid JSON: {str(exc).splitlines()[0] if str(exc) else 'too deep'}",
                             source) from None
-
-
-def _reject_constant(name: str):
-    raise ValueError(f"{name} is not JSON")
-
-
-def _unique_keys(pairs: list) -> dict:
-    seen = {}
-    for key, value in pairs:
-        if key in seen:
-            raise ValueError(f"duplicate key {_clip(key)!r}")
-        seen[key] = value
-    return seen
 
 
 def summary(a: Artifact) -> str:

@@ -8,7 +8,6 @@ no dict-order dependence, so the same inputs give byte-identical sources.
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
 import jinja2
@@ -17,6 +16,7 @@ import numpy as np
 from codegen import atomic
 from codegen.artifact import comment_text_problem, hex_float
 from codegen.errors import CodegenError
+from codegen.names import identifier_problem, show
 
 SHARED_TEMPLATES = Path(__file__).with_name("templates")
 CSRC = Path(__file__).with_name("csrc")
@@ -41,11 +41,11 @@ def comment(text) -> str:
 
 
 def check_name(name: str) -> str:
-    """Entry names become C identifiers and file names: lower-case, not the math library's prefix."""
-    if not re.fullmatch(r"[a-z][a-z0-9_]{0,30}", name) or name.startswith("sg_"):
-        raise CodegenError(
-            f"--name: {name!r} must be a lower-case C identifier (a-z, 0-9, _; at most 31 characters) "
-            "not starting with 'sg_'")
+    """Entry names become C identifiers and file names (codegen.names.identifier_problem; a
+    package's name is checked against the stricter codegen.names.name_problem where it is read)."""
+    problem = identifier_problem(name)
+    if problem:
+        raise CodegenError(f"entry name {show(name)}: {problem}")
     return name
 
 

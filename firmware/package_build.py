@@ -16,6 +16,7 @@ import subprocess
 from pathlib import Path
 from typing import Sequence
 
+from codegen.names import name_problem, show
 from firmware.errors import FirmwareError
 
 HERE = Path(__file__).resolve().parent
@@ -32,7 +33,6 @@ _ARM_TOOLCHAINS = {"gcc": (TOOLCHAIN, ("arm-none-eabi-gcc",)),
 # above the 128 KB the STM32F417 map uses, so the copy to RAM and its CRC run as on the board.
 CCM_REGION = "CCM   (rw)  : ORIGIN = 0x10000000, LENGTH = 64K"
 QEMU_CCM_REGION = "CCM   (rw)  : ORIGIN = 0x20020000, LENGTH = 64K"
-_NAME = re.compile(r"[a-z][a-z0-9_]{0,30}")
 _FLAG = re.compile(r"-[A-Za-z0-9_=+.,-]+")
 
 
@@ -88,8 +88,9 @@ def build_image(package_dir: str | Path, name: str, target: str, build_dir: str 
         raise FirmwareError(f"package build: unknown target {target!r} (choose from {', '.join(TARGETS)})")
     if compiler not in COMPILERS:
         raise FirmwareError(f"package build: unknown compiler {compiler!r} (choose from {', '.join(COMPILERS)})")
-    if not _NAME.fullmatch(name):
-        raise FirmwareError(f"package build: {name!r} is not a package name")
+    problem = name_problem(name)
+    if problem:
+        raise FirmwareError(f"package build: package name {show(name)}: {problem}")
     for f in c_flags:
         if not _FLAG.fullmatch(f):
             raise FirmwareError(f"package build: {f!r} is not a plain compiler option")

@@ -11,25 +11,23 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from codegen import atomic
+from codegen import atomic, reading, values
 from codegen.errors import CodegenError
+from codegen.names import NAME, name_problem
 from codegen.units.controller.spec import ControllerConfig
 
 FORMAT = "staregen.controller-config"
 VERSION = 1
 KNOWN_UNITS = ("controller", "tanh")
-NAME_PATTERN = re.compile(r"[a-z][a-z0-9_]{0,11}")   # <name>_selftest_reference stays within C99's 31 characters
+NAME_PATTERN = NAME     # the one package-name rule: codegen.names
 MAX_DWELL = 1_000_000
 MAX_PERIOD_S = 10.0
-FLOAT32_MAX = float(np.finfo(np.float32).max)
+FLOAT32_MAX = values.FLOAT32_MAX
 
 # table -> key -> kind; kinds: "vec3>=0", ">0", ">=0", "[0,1)", "int>=1", "name", "units"
 SCHEMA: dict[str, dict[str, str]] = {
@@ -80,29 +78,22 @@ class PackageConfig:
 
 # ----------------------------------------------------------------------------- validation
 
-def _is_real(v) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
-
-
-def _real(v, key: str) -> float:
-    if not _is_real(v):
-        raise ConfigError(f"{key}: must be a number, got {show_value(v)}")
-    if not math.isfinite(v) or abs(v) > FLOAT32_MAX:
-        raise ConfigError(f"{key}: must be finite (and within float32), got {show_value(v)}")
-    return float(v)
-
-
 def show_value(v) -> str:
-    text = repr(v)
-    return text if len(text) <= 40 else text[:37] + "..."
+    return values.show(v)
+
+
+def _real(v, key: str, low: float | None = None, high: float | None = None, **ends) -> float:
+    """The file's float64 value, after checking its float32 rounding (what the C holds) is in range."""
+    values.float32_in(v, key, low, high, error=ConfigError, **ends)
+    return float(v)
 
 
 def _value(kind: str, v, key: str):
     """The value of one key, normalised (reals to float), or a one-line ConfigError."""
     if kind == "name":
-        if not isinstance(v, str) or not NAME_PATTERN.fullmatch(v) or v.startswith("sg_"):
-            raise ConfigError(f"{key}: must be a lower-case C identifier of at most 12 characters "
-                              f"(a-z, 0-9, _), not starting with 'sg_'; got {show_value(v)}")
+        problem = name_problem(v)
+        if problem:
+            raise ConfigError(f"{key}: {problem} (got {show_value(v)})")
         return v
     if kind == "units":
         if not isinstance(v, list) or not all(isinstance(u, str) for u in v):
@@ -116,11 +107,7 @@ def _value(kind: str, v, key: str):
             raise ConfigError(f"{key}: must include \"controller\" (the package's main unit)")
         return tuple(u for u in KNOWN_UNITS if u in v)
     if kind == "int>=1":
-        if not isinstance(v, int) or isinstance(v, bool):
-            raise ConfigError(f"{key}: must be an integer, got {show_value(v)}")
-        if not 1 <= v <= MAX_DWELL:
-            raise ConfigError(f"{key}: must be in [1, {MAX_DWELL}], got {v}")
-        return v
+        return values.integer_in(v, key, 1, MAX_DWELL, ConfigError)
     if kind == "vec3>=0":
         if not isinstance(v, list) or len(v) != 3:
             raise ConfigError(f"{key}: must be a list of 3 numbers (x, y, z), got {show_value(v)}")
@@ -129,14 +116,13 @@ def _value(kind: str, v, key: str):
             if x < 0:
                 raise ConfigError(f"{key}[{i}]: a gain must not be negative, got {x:g}")
         return out
-    x = _real(v, key)
-    if kind == ">0" and not x > 0:
-        raise ConfigError(f"{key}: must be > 0, got {x:g}")
-    if kind == "period" and not 0 < x <= MAX_PERIOD_S:
-        raise ConfigError(f"{key}: must be in (0, {MAX_PERIOD_S:g}] s, got {x:g}")
-    if kind == "[0,1)" and not 0 <= x < 1:
-        raise ConfigError(f"{key}: must be in [0, 1), got {x:g}")
-    return x
+    if kind == ">0":
+        return _real(v, key, 0.0, low_open=True)
+    if kind == "period":
+        return _real(v, key, 0.0, MAX_PERIOD_S, low_open=True, unit="s")
+    if kind == "[0,1)":
+        return _real(v, key, 0.0, 1.0, high_open=True)
+    raise ValueError(f"{key}: unknown schema kind {kind!r}")
 
 
 def _check(data) -> dict:
@@ -210,25 +196,30 @@ def from_mapping(data: dict, sealed: bool = True) -> PackageConfig:
     return PackageConfig(v["package"]["name"], v["package"]["units"], controller)
 
 
-def _read(path: Path) -> dict:
+def _read(path: Path) -> tuple[str, dict]:
+    """The file's text (a capped read of a regular file) and its TOML tables."""
     try:
-        text = path.read_bytes().decode("utf-8")
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    except UnicodeDecodeError:
-        raise ConfigError(f"{path}: not UTF-8 text") from None
+        text = reading.read_text(path)
+    except reading.InputFileError as exc:
+        raise ConfigError(str(exc)) from None
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:   # also duplicate keys and tables
+        raise ConfigError(f"{path}: not valid TOML: {str(exc).splitlines()[0]}") from None
+    except ValueError as exc:      # an integer of more than 4300 digits
         raise ConfigError(f"{path}: not valid TOML: {str(exc).splitlines()[0]}") from None
     except RecursionError:
         raise ConfigError(f"{path}: not valid TOML: nested too deeply") from None
+    problem = values.toml_number_problem(text)
+    if problem:
+        raise ConfigError(f"{path}: {problem}")
+    return text, data
 
 
 def load(path: str | Path, sealed: bool = True) -> PackageConfig:
     """Read and validate a controller.toml; every error is one `ConfigError` line naming file and key."""
     path = Path(path)
-    data = _read(path)
+    _, data = _read(path)
     try:
         return from_mapping(data, sealed)
     except ConfigError as exc:
@@ -310,12 +301,11 @@ def seal(path: str | Path) -> tuple[str, bool]:
     """Recompute the seal of a hand-edited file after validating every value; rewrites only the
     `sha256 = "..."` line (comments and layout stay). Returns (seal, whether it changed)."""
     path = Path(path)
-    data = _read(path)
+    text, data = _read(path)
     try:
         cfg = from_mapping(data, sealed=False)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
-    text = path.read_text(encoding="utf-8")
     new = f'sha256 = "{cfg.sha256}"'
     lines = _SEAL_LINE.findall(text)
     if len(lines) != 1:

@@ -12,6 +12,7 @@ import hashlib
 from pathlib import Path
 
 from codegen import artifact as art
+from codegen import reading
 from codegen.package import config as pc
 from codegen.package.manifest import load_key
 from codegen.package.selftest import MAX_VECTORS
@@ -61,9 +62,9 @@ def evidence_plan(args: argparse.Namespace) -> EvidencePlan:
 
 def file_sha256(path: Path) -> str:
     try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError as exc:
-        raise HostError(f"{path}: cannot read ({exc.strerror or exc})") from None
+        return hashlib.sha256(reading.read_bytes(path)).hexdigest()
+    except reading.InputFileError as exc:
+        raise HostError(str(exc)) from None
 
 
 def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen import units
+from codegen.names import name_problem, show
 from codegen.unit import Unit
 from codegen.units.dp import tables as dp_tables
 from codegen.units.tanh.params import load_params
@@ -49,6 +50,8 @@ def unit_from_args(args: argparse.Namespace) -> Unit:
     for flag, value in given.items():
         if value is not None and flag not in kind.needs:
             raise HostError(f"--{flag} does not apply to unit {args.unit}")
+    if args.name is not None and name_problem(args.name):    # the package-name rule: derived entries stay valid
+        raise HostError(f"--name: {name_problem(args.name)} (got {show(args.name)})")
     inputs = {"name": args.name}
     if args.period is not None:
         if "params" not in kind.needs:

@@ -13,11 +13,11 @@ outputs N·m.
 """
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 
 import numpy as np
 
+from codegen import reading
 from host.errors import HostError
 from host.plant.spacecraft import TABLE6
 
@@ -122,11 +122,9 @@ def load_baselines(path) -> tuple[LinearLS, SaturatedLinear]:
     """The two fitted laws of a baselines file (written by `staregen train` / the pipeline)."""
     where = str(path)
     try:
-        doc = json.loads(open(path, encoding="utf-8").read())
-    except OSError as exc:
-        raise HostError(f"{where}: cannot read ({exc.strerror or exc})") from None
-    except ValueError:
-        raise HostError(f"{where}: not valid JSON") from None
+        doc = reading.read_json(path)    # capped, regular files only, strict JSON
+    except reading.InputFileError as exc:
+        raise HostError(str(exc)) from None
     if not isinstance(doc, dict) or doc.get("format") != BASELINES_FORMAT:
         raise HostError(f"{where}: not a baselines file (format {BASELINES_FORMAT})")
     linear, pdff = LinearLS(_coef(doc, "linear", where)), _coef(doc, "pdff", where)

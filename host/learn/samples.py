@@ -306,8 +306,12 @@ def load_dataset(directory, include_failed: bool = False):
     """
     directory = Path(directory)
     manifest = read_manifest(directory)
-    plan = plan_from_manifest(manifest)
-    if plan.config_hash() != manifest["config_hash"]:
+    try:
+        plan = plan_from_manifest(manifest)
+    except (KeyError, TypeError, ValueError, AttributeError) as exc:   # a hand-edited manifest: fields missing or of other types
+        raise HostError(f"{directory / MANIFEST}: malformed dataset manifest ({type(exc).__name__}: "
+                        f"{str(exc)[:60]})") from None
+    if plan.config_hash() != manifest.get("config_hash"):
         raise HostError(f"{directory / MANIFEST}: config hash does not match its own settings "
                         "(edited by hand, or made by another version of the OCP formulation or spacecraft model)")
     missing = [i for i in range(plan.n_shards) if not shard_is_finished(directory, i)]

@@ -5,25 +5,21 @@ one-line HostError telling what to delete."""
 from __future__ import annotations
 
 import hashlib
-import json
 from pathlib import Path
 
+from codegen import reading
 from host.errors import HostError
 
 
 def read_json(path: Path, what: str) -> dict:
-    """A JSON object (strict: no NaN or Infinity), or a one-line HostError naming the file."""
+    """A JSON object (capped, strict read: codegen.reading); anything else is one HostError line."""
     try:
-        doc = json.loads(Path(path).read_text(), parse_constant=_refuse_constant)
-    except (OSError, ValueError) as exc:
-        raise HostError(f"{path}: unreadable {what} ({type(exc).__name__})") from None
+        doc = reading.read_json(path)
+    except reading.InputFileError as exc:
+        raise HostError(f"{path}: unreadable {what} ({str(exc).removeprefix(f'{path}: ')})") from None
     if not isinstance(doc, dict):
-        raise HostError(f"{path}: the {what} is not a JSON object (got a {type(doc).__name__})")
+        raise HostError(f"{path}: unreadable {what} (expected a JSON object, got {type(doc).__name__})")
     return doc
-
-
-def _refuse_constant(name: str):
-    raise ValueError(f"{name} is not JSON")
 
 
 def check_place(json_path: Path, sidecar: dict, place: dict, index: int, owner: str) -> None:

@@ -21,7 +21,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from codegen import atomic
+from codegen import atomic, reading
 # the controller configuration's canonical form (reals as float.hex) and value display: one
 # definition of "the same values" and of a one-line shown value across the sealed files
 from codegen.package.config import canonical_form
@@ -319,12 +319,11 @@ def default_scenario() -> Scenario:
 
 def _read(path: Path) -> dict:
     try:
-        with path.open("rb") as fh:
-            raw = fh.read(MAX_FILE_BYTES + 1)
-    except OSError as exc:
-        raise ScenarioError(f"{path}: cannot read ({exc.strerror or exc})") from None
-    if len(raw) > MAX_FILE_BYTES:
-        raise ScenarioError(f"{path}: larger than {MAX_FILE_BYTES // 1024} KiB; not a scenario file")
+        raw = reading.read_bytes(path, MAX_FILE_BYTES)     # regular files only: a FIFO would block
+    except reading.FileTooLargeError:
+        raise ScenarioError(f"{path}: larger than {MAX_FILE_BYTES // 1024} KiB; not a scenario file") from None
+    except reading.InputFileError as exc:
+        raise ScenarioError(str(exc)) from None
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

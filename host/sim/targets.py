@@ -16,6 +16,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from codegen import reading
 from codegen.number_text import parse_real
 from host.core.constants import DEG, EARTH_MEAN_RADIUS
 from host.errors import HostError
@@ -114,9 +115,9 @@ def load_target_list(path) -> list[Target]:
     blank lines and `#` comments ignored. Any bad row is a one-line HostError naming the line."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise HostError(f"{p}: cannot read the target list ({getattr(exc, 'strerror', None) or type(exc).__name__})") from None
+        text = reading.read_text(p)      # capped, regular files only
+    except reading.InputFileError as exc:
+        raise HostError(f"{exc} (target list)") from None
     targets = []
     for number, raw in enumerate(text.splitlines(), 1):
         line = raw.split("#", 1)[0].strip()

@@ -9,6 +9,7 @@ import torch
 
 import host.cli as cli
 from codegen import artifact as art
+from codegen.errors import CodegenError
 from codegen.units.network import golden
 
 CODEGEN_COMMANDS = ["host.cli.artifact", "host.cli.codegen", "host.cli.c_eval", "host.cli.verify"]
@@ -162,6 +163,41 @@ def test_rejects_invalid_json_and_missing_file(tmp_path):
         art.load(bad)
     with pytest.raises(art.ArtifactError, match="no such file"):
         art.load(tmp_path / "missing.json")
+
+
+def test_only_regular_files_are_read_and_reads_are_capped(tmp_path, monkeypatch):
+    """Issue 25: the 64 MiB cap trusted st_size, so /dev/zero (size 0) was read until memory ran
+    out (the CLI table has that row). Now a device, FIFO or folder is refused, and the cap counts
+    the bytes actually read: /proc/self/status is a regular file whose st_size is 0."""
+    with pytest.raises(art.ArtifactError, match=r"file: cannot read \(not a regular file\)"):
+        art.load(tmp_path)
+    monkeypatch.setattr(art, "MAX_FILE_BYTES", 100)
+    with pytest.raises(art.ArtifactError, match="file: larger than 100 bytes"):
+        art.load("/proc/self/status")
+
+
+@pytest.mark.parametrize("shape", [(10_000, 10_000, 10_000), (10_000, 1_000, 10)])
+def test_shapes_an_artifact_cannot_hold_are_refused_before_allocating(shape):
+    """Issue 25: `artifact random --shape 10000-10000-10000` allocated 800 MB of float64 first."""
+    assert art.n_parameters(shape) > art.MAX_PARAMETERS
+    text = "-".join(map(str, shape))
+    with pytest.raises(CodegenError, match="more than the 4,194,304 an artifact may hold"):
+        art.parse_shape(text)
+    with pytest.raises(CodegenError, match="more than the 4,194,304 an artifact may hold"):
+        art.random_artifact(shape)
+    assert art.parse_shape("12-10000-3") == (12, 10_000, 3)      # the largest the README names still fits
+    assert art.random_artifact((12, 20_000, 3)).n_hidden == 20_000   # too large for flash, not for a file
+
+
+def test_a_document_claiming_a_shape_no_artifact_may_hold_is_refused(tmp_path, document):
+    document["payload"]["network"]["sizes"] = [10_000, 10_000, 10_000]
+    err = rejection(tmp_path, reseal(document))
+    assert err.field_path == "payload.network.sizes" and "may hold" in err.reason
+
+
+def test_shape_digits_are_ascii():
+    with pytest.raises(CodegenError, match="--shape"):
+        art.parse_shape("\u0661\u0662-40-3")
 
 
 def test_from_arrays_rejects_non_finite_weights_with_the_same_path():

@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from codegen import values
 from codegen.errors import CodegenError
 
 N_IN, N_OUT = 12, 3
@@ -14,6 +15,9 @@ MAX_ITERATIONS = 20
 LAST_SIDE = 2.0               # a box of side 2·range centred inside the range holds every sample
 MAX_LEVELS = 64               # boxed levels at most (r and widen are refused beyond it)
 MAX_TUKEY_C = 1000.0
+# (key, low, high, low open, high open) of the reals, checked once more after rounding to float32
+FLOAT32_RANGES = (("r", 0.0, 1.0, True, True), ("widen", 1.0, 4.0, True, False),
+                  ("tukey_c", 0.0, MAX_TUKEY_C, True, False), ("ridge", 0.0, 1.0, False, False))
 
 
 class DpParamsError(CodegenError):
@@ -62,6 +66,9 @@ class DpParams:
         if not (number(self.tukey_c) and 0 < self.tukey_c <= MAX_TUKEY_C and number(self.ridge)
                 and 0 <= self.ridge <= 1):
             raise DpParamsError(f"discrete-point tukey_c must lie in (0, {MAX_TUKEY_C:g}] and ridge in [0, 1]")
+        for key, low, high, low_open, high_open in FLOAT32_RANGES:   # again on the float32 the C holds
+            values.float32_in(getattr(self, key), f"discrete-point {key}", low, high, low_open=low_open,
+                              high_open=high_open, error=DpParamsError)
         return self
 
     def sides(self) -> tuple[float, ...]:

@@ -21,6 +21,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION, detmath
 from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
 from codegen.errors import CodegenError
+from codegen.values import float32_in
 from codegen.detmath import TANH_COLS, TANH_HALF, tanh_rows
 from codegen.units.tanh.powtab import PowTab, pow_tables
 from codegen.units.tanh.params import TanhParams, derived_constants
@@ -65,7 +66,7 @@ def constants32(p: TanhParams, period: float) -> Constants32:
     """The float64 constants of the law, each rounded to float32 once."""
     period = check_period(period)
     d = derived_constants(p)
-    values = {
+    constants = {
         "nk1": -p.k1, "nk2": -p.k2, "k2": p.k2, "k3": p.k3,
         "eps1": p.eps1, "eps2": p.eps2, "eps3": p.eps3,
         "nbeta1": -p.beta1, "beta2": p.beta2, "gamma": p.gamma, "gamma_m1": p.gamma - 1.0, "eta": p.eta,
@@ -77,14 +78,16 @@ def constants32(p: TanhParams, period: float) -> Constants32:
         "q0min_sq": p.q0_min ** 2, "q0min_sq4": 4.0 * p.q0_min ** 2,
         "period": period, "limit": p.varpi_limit,
     }
-    with np.errstate(over="raise"):
-        try:
-            scalars = {k: np.float32(v) for k, v in values.items()}
-            J = np.asarray(d["J"], dtype=np.float32).reshape(9)
-            J_inv = np.asarray(d["J_inv"], dtype=np.float32).reshape(9)
-        except FloatingPointError:
-            raise CodegenError("a tanh-law constant overflows float32 (check the parameter magnitudes)") from None
+    # derived constants follow the parameters' float32 rule (codegen.values): none may overflow,
+    # none nonzero may become 0 or a subnormal
+    scalars = {k: _constant32(v, k) for k, v in constants.items()}
+    J = np.array([_constant32(v, f"J[{i}]") for i, v in enumerate(np.ravel(d["J"]))], dtype=np.float32)
+    J_inv = np.array([_constant32(v, f"J_inv[{i}]") for i, v in enumerate(np.ravel(d["J_inv"]))], dtype=np.float32)
     return Constants32(scalars, J, J_inv)
+
+
+def _constant32(value, name: str) -> np.float32:
+    return float32_in(float(value), f"tanh-law constant {name}")
 
 
 def params_sha256(p: TanhParams, period: float) -> str:

@@ -6,14 +6,13 @@ CodegenError, so the CLI prints them as one line).
 """
 from __future__ import annotations
 
-import json
-import math
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from codegen import reading, values
 from codegen.errors import CodegenError
 
 
@@ -94,8 +93,9 @@ def _validate(p: TanhParams) -> None:
         if key == "inertia":
             continue
         value = getattr(p, _FIELD_OF_KEY.get(key, key))
-        if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-            raise TanhParamsError(f"'{key}' must be a finite number, got {value!r}")
+        if not values.is_number(value):
+            raise TanhParamsError(f"'{key}' must be a finite number, got {values.show(value)}")
+        values.real(value, f"'{key}'", TanhParamsError)     # finite, within float32 (also a 400-digit integer)
     for key in _POSITIVE_KEYS + _OPTIONAL_KEYS:
         value = getattr(p, _FIELD_OF_KEY.get(key, key))
         if value <= 0:
@@ -104,16 +104,28 @@ def _validate(p: TanhParams) -> None:
         raise TanhParamsError(f"'gamma' = {p.gamma!r} must be in (0, 1)")
     if not p.q0_min < 0.5:
         raise TanhParamsError(f"'q0_min' = {p.q0_min!r} must be < 0.5 (it guards only the 180° neighbourhood)")
+    _validate_float32(p)
     _validate_inertia(p.inertia)
 
 
+def _validate_float32(p: TanhParams) -> None:
+    """The ranges again on the float32 the C holds (1e-50 would become 0, 0.99999999 would become 1)."""
+    for key in _POSITIVE_KEYS + _OPTIONAL_KEYS:
+        values.float32_in(getattr(p, _FIELD_OF_KEY.get(key, key)), f"'{key}'", 0.0, low_open=True,
+                          error=TanhParamsError)
+    values.float32_in(p.gamma, "'gamma'", 0.0, 1.0, low_open=True, high_open=True, error=TanhParamsError)
+
+
 def _validate_inertia(inertia) -> None:
-    try:
-        J = np.array(inertia, dtype=float)
-    except (TypeError, ValueError):
-        raise TanhParamsError(f"'inertia' must be a 3x3 matrix of numbers, got {inertia!r}") from None
-    if J.shape != (3, 3) or not np.all(np.isfinite(J)):
-        raise TanhParamsError(f"'inertia' must be a finite 3x3 matrix, got shape {J.shape}")
+    if isinstance(inertia, np.ndarray):
+        inertia = inertia.tolist()
+    if (not isinstance(inertia, (list, tuple)) or len(inertia) != 3
+            or not all(isinstance(row, (list, tuple)) and len(row) == 3 for row in inertia)):
+        raise TanhParamsError(f"'inertia' must be a finite 3x3 matrix, got {values.show(inertia)}")
+    for i, row in enumerate(inertia):
+        for j, x in enumerate(row):   # numbers only: no "2_4.6" strings or booleans through float()
+            values.float32_in(x, f"'inertia'[{i}][{j}]", error=TanhParamsError)
+    J = np.array(inertia, dtype=float)
     if not np.allclose(J, J.T, rtol=0, atol=1e-12 * np.max(np.abs(J))):
         raise TanhParamsError("'inertia' must be symmetric")
     if np.min(np.linalg.eigvalsh(J)) <= 0:
@@ -140,20 +152,20 @@ def params_from_mapping(data: dict) -> TanhParams:
 def load_params(path: str | Path) -> TanhParams:
     """Read a .toml or .json parameter file (flat keys, see TanhParams) and validate it."""
     path = Path(path)
+    if path.suffix not in (".toml", ".json"):
+        raise TanhParamsError(f"{path}: parameter file must end in .toml or .json")
     try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise TanhParamsError(f"{path}: cannot read parameter file ({exc.strerror})") from None
+        text = reading.read_text(path)
+    except reading.InputFileError as exc:
+        raise TanhParamsError(str(exc)) from None
     try:
-        if path.suffix == ".toml":
-            data = tomllib.loads(raw.decode("utf-8"))
-        elif path.suffix == ".json":
-            data = json.loads(raw)
-        else:
-            raise TanhParamsError(f"{path}: parameter file must end in .toml or .json")
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError, UnicodeDecodeError) as exc:
-        first_line = str(exc).splitlines()[0]
+        data = tomllib.loads(text) if path.suffix == ".toml" else reading.parse_json(text)
+    except (ValueError, RecursionError) as exc:   # syntax, duplicate keys, NaN, integers of > 4300 digits
+        first_line = str(exc).splitlines()[0] if str(exc) else "nested too deeply"
         raise TanhParamsError(f"{path}: not valid {path.suffix[1:].upper()}: {first_line}") from None
+    problem = values.toml_number_problem(text) if path.suffix == ".toml" else None
+    if problem:
+        raise TanhParamsError(f"{path}: {problem}")
     try:
         return params_from_mapping(data)
     except TanhParamsError as exc:

@@ -122,5 +122,5 @@ def test_bad_requests(units):
         make_vectors(c, 0)
     with pytest.raises(CodegenError, match="first unit must be the stateful controller"):
         selftest_sources("stare", [make_vectors(configure_unit("network", artifact=random_artifact((12, 4, 3))), 4)])
-    with pytest.raises(CodegenError, match="--name"):
+    with pytest.raises(CodegenError, match=r"entry name 'Bad\*/'"):
         selftest_sources("Bad*/", [make_vectors(c, 4)])

@@ -10,7 +10,12 @@ import os
 import numpy as np
 import pytest
 
-from codegen.artifact import random_artifact
+from codegen.artifact import random_artifact, sealed
+from codegen.units.dp import tables as dp_tables
+from codegen.units.dp.params import DpParams
+from codegen.units.tanh.params import example_params
+from host.learn.ocp import OcpConfig
+from host.learn.samples import DatasetPlan, open_dataset_dir
 from host.cli import build_parser, main
 from host.control.nn_controller import CONFIG_SOURCES, default_package_config
 from codegen.package import config as pc
@@ -187,7 +192,7 @@ CASES = [
     (["report", "--command", "staregen evaluate", "--evaluate", "{tmp}/none", "--out", "{tmp}/r"],
      "staregen report: error: --evaluate"),
     (["tune", "pid", "--targets", "central", "--out", "{tune_list}"],
-     "tuning.json: the tuning plan is not a JSON object"),
+     "tuning.json: unreadable tuning plan (expected a JSON object, got list)"),
     (["tune", "pid", "--grid", "kp=1.7e308,ki=0,kd=40", "--targets", "central", "--duration", "12", "--out", "{tmp}/t"],
      "--grid kp: a value the controller configuration cannot hold"),
     (["tune", "pid", "--grid", "kp=1_0,ki=0,kd=40", "--duration", "5", "--out", "{tmp}/t"], "grid kp=1_0"),
@@ -213,6 +218,40 @@ CASES = [
     (["package", "check", "{dir}", "--verify-key", "{file}"], "a key needs at least 32 bytes"),
     (["package", "check", "{dir}", "--verify-key", "{tmp}/none.key"], "cannot read the key"),
     (["package", "check", "{dir}", "--run", "x86,qemu2"], "unknown target 'qemu2'"),
+    # issue 25 (parameter files): ranges after float32 rounding, one name rule, no tracebacks,
+    # capped reads of regular files, one number grammar; files from _issue25_parameter_files
+    (["config", "check", "{tmp}/p25/torque_limit.toml"], "limits.torque_limit: 1e-50 rounds to 0 in float32"),
+    (["config", "check", "{tmp}/p25/integral_limit.toml"], "pid.integral_limit: 1e-50 rounds to 0 in float32"),
+    (["config", "check", "{tmp}/p25/control_period.toml"], "timing.control_period: 1e-50 rounds to 0 in float32"),
+    (["config", "check", "{tmp}/p25/e2.toml"], "earth.e2: must be in [0, 1), got 0.9999999999999999 (as float32: 1.0)"),
+    (["config", "check", "{tmp}/p25/name_sg.toml"], "package.name: must not be 'sg'"),
+    (["config", "check", "{tmp}/p25/name_image.toml"], "package.name: must not be a CMake-reserved target"),
+    (["generate", "--config", "{tmp}/p25/name_sg.toml", "--network", "{net}", "--out", "{tmp}/pkg"], "package.name"),
+    (["codegen", "--unit", "controller", "--artifact", "{net}", "--name", "sg", "--out", "{tmp}/c"],
+     "--name: must not be 'sg'"),
+    (["config", "check", "{tmp}/p25/digits.toml"], "limits.torque_limit: must be finite (and within float32)"),
+    (["config", "seal", "{tmp}/p25/digits.toml"], "limits.torque_limit: must be finite (and within float32)"),
+    (["config", "check", "{tmp}/p25/underscore.toml"], "number '1_0.0': write plain decimal digits"),
+    (["config", "check", "/dev/zero"], "/dev/zero: cannot read (not a regular file)"),
+    (["config", "seal", "/dev/zero"], "/dev/zero: cannot read (not a regular file)"),
+    (["artifact", "check", "/dev/zero"], "/dev/zero: file: cannot read (not a regular file)"),
+    (["generate", "--config", "{cfg}", "--network", "{net}", "--tanh", "{tmp}/p25/zero.toml", "--out", "{tmp}/pkg"],
+     "zero.toml: cannot read (not a regular file)"),
+    (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "more than the 4,194,304 an artifact may hold"),
+    (["tanh", "gate", "--params", "{tmp}/p25/eps1.toml"], "'eps1': 1e-50 rounds to 0 in float32"),
+    (["tanh", "gate", "--params", "{tmp}/p25/eta.toml"], "'eta': 1e-300 rounds to 0 in float32"),
+    (["tanh", "gate", "--params", "{tmp}/p25/gamma.json"], "'gamma': 1e-300 rounds to 0 in float32"),
+    (["tanh", "gate", "--params", "{tmp}/p25/k1_digits.json"], "'k1': must be finite (and within float32)"),
+    (["tanh", "gate", "--params", "{tmp}/p25/inertia_text.json"], "'inertia'[0][0]: must be a number, got '2_4.6'"),
+    (["tanh", "gate", "--params", "{tmp}/p25/inertia_bool.json"], "'inertia'[0][1]: must be a number, got True"),
+    (["tanh", "gate", "--params", "{tmp}/p25/duplicate.json"], "not valid JSON: duplicate key 'k1'"),
+    (["verify", "--unit", "tanh", "--params", "{tmp}/p25/underscore_tanh.toml"], "number '1_5.0'"),
+    (["codegen", "--unit", "dp", "--tables", "{tmp}/p25/dp_tukey.json", "--out", "{tmp}/c"],
+     "tukey_c: 1e-300 rounds to 0 in float32"),
+    (["dp", "build", "--data", "{tmp}/p25/ds_manifest", "--out", "{tmp}/t.json"],
+     "dataset.json: unreadable dataset manifest (expected a JSON object, got list)"),
+    (["dp", "build", "--data", "{tmp}/p25/ds_sidecar", "--out", "{tmp}/t.json"],
+     "shard-00000.json: unreadable shard sidecar (expected a JSON object, got list)"),
 ]
 
 
@@ -258,6 +297,45 @@ def _issue25_files(folder) -> dict[str, str]:
     return {**out, "targets_underscore": str(folder / "targets_underscore.csv")}
 
 
+def _issue25_parameter_files(folder) -> None:
+    """Issue 25: parameter files with one defect each, in folder/p25 (a valid file edited; the
+    value checks come before the seal's)."""
+    out = folder / "p25"
+    out.mkdir()
+    good = pc.to_toml(default_package_config())
+    edits = {"torque_limit": ("torque_limit = 1.0", "torque_limit = 1e-50"),
+             "integral_limit": ("integral_limit = 100.0", "integral_limit = 1e-50"),
+             "control_period": ("control_period = 0.1", "control_period = 1e-50"),
+             "e2": ("e2 = 0.0066943799901413165", "e2 = 0.9999999999999999"),
+             "name_sg": ('name = "stare"', 'name = "sg"'), "name_image": ('name = "stare"', 'name = "image"'),
+             "digits": ("torque_limit = 1.0", "torque_limit = " + "9" * 400),
+             "underscore": ("torque_limit = 1.0", "torque_limit = 1_0.0")}
+    for name, (old, new) in edits.items():
+        assert old in good, old
+        (out / f"{name}.toml").write_text(good.replace(old, new))
+    (out / "zero.toml").symlink_to("/dev/zero")
+    tanh = example_params().to_mapping()
+
+    def tanh_file(name: str, text: str) -> None:
+        (out / name).write_text(text)
+    toml = "".join(f"{k} = {json.dumps(v)}\n" for k, v in tanh.items())
+    tanh_file("eps1.toml", toml.replace("eps1 = 20.0", "eps1 = 1e-50"))
+    tanh_file("eta.toml", toml.replace("eta = 0.002", "eta = 1e-300"))
+    tanh_file("underscore_tanh.toml", toml.replace("k3 = 0.8", "k3 = 1_5.0"))
+    tanh_file("gamma.json", json.dumps({**tanh, "gamma": 1e-300}))
+    tanh_file("k1_digits.json", json.dumps({**tanh, "k1": 10 ** 400}))
+    tanh_file("inertia_text.json", json.dumps({**tanh, "inertia": [["2_4.6", 0.1, 0.0], *tanh["inertia"][1:]]}))
+    tanh_file("inertia_bool.json", json.dumps({**tanh, "inertia": [[3.0, True, 0.0], [True, 2.0, -0.2],
+                                                                    [0.0, -0.2, 4.0]]}))
+    tanh_file("duplicate.json", json.dumps(tanh)[:-1] + ', "k1": 2.0}')
+    payload = json.loads(json.dumps(dp_tables.random_tables(60, DpParams(s_limit=32, n_min=20)).payload()))
+    payload["params"]["tukey_c"] = 1e-300
+    tanh_file("dp_tukey.json", json.dumps(sealed(dp_tables.FORMAT, dp_tables.VERSION, payload)))
+    for name, broken in (("ds_manifest", "dataset.json"), ("ds_sidecar", "shard-00000.json")):
+        open_dataset_dir(out / name, DatasetPlan(2, OcpConfig(), shard_size=2))
+        (out / name / broken).write_text("[]")
+
+
 @pytest.fixture()
 def places(tmp_path, monkeypatch):
     monkeypatch.chdir(os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(__file__)))))
@@ -269,7 +347,9 @@ def places(tmp_path, monkeypatch):
     np.save(tmp_path / "x0.npy", np.zeros((0, 12), np.float32))
     pc.write(default_package_config(), tmp_path / "controller.toml", CONFIG_SOURCES)
     (tmp_path / "deep.json").write_text("[" * 100_000 + "]" * 100_000)
-    return {**_bad_scenarios(tmp_path), **_issue25_files(tmp_path), "tmp": str(tmp_path), "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
+    _issue25_parameter_files(tmp_path)
+    return {**_bad_scenarios(tmp_path), **_issue25_files(tmp_path), "tmp": str(tmp_path),
+            "net": str(tmp_path / "net.json"), "small": str(tmp_path / "small.json"),
             "file": str(tmp_path / "file.txt"), "dir": str(tmp_path / "folder"), "x": str(tmp_path / "x.npy"),
             "x0": str(tmp_path / "x0.npy"), "cfg": str(tmp_path / "controller.toml"), "deep": str(tmp_path / "deep.json")}
 

@@ -134,6 +134,24 @@ def test_corrupt_truncated_foreign_or_missing_shards_are_one_line_errors(tmp_pat
     assert "incomplete" in _one_line_error(excinfo)
 
 
+@pytest.mark.parametrize("target, text, needle", [
+    ("manifest", "[]", "dataset.json: unreadable dataset manifest (expected a JSON object, got list)"),
+    ("sidecar", "[]", "shard-00000.json: unreadable shard sidecar (expected a JSON object, got list)"),
+    ("sidecar", '{"shard": 0, "shard": 1}', "shard-00000.json: unreadable shard sidecar (not valid JSON: duplicate key"),
+    ("manifest", None, "dataset.json: malformed dataset manifest (KeyError"),
+])
+def test_a_manifest_or_sidecar_that_is_not_the_expected_object_is_one_line(tmp_path, target, text, needle):
+    """Issue 25: `[]` in dataset.json or a shard sidecar was an AttributeError traceback."""
+    _fake_dataset(tmp_path, DatasetPlan(4, OcpConfig(), shard_size=2))
+    manifest = tmp_path / "dataset.json"
+    if text is None:    # the right format, its other fields gone
+        text = json.dumps({"format": json.loads(manifest.read_text())["format"]})
+    (manifest if target == "manifest" else shard_paths(tmp_path, 0)[1]).write_text(text)
+    with pytest.raises(HostError) as excinfo:
+        load_dataset(tmp_path)
+    assert needle in _one_line_error(excinfo)
+
+
 def test_swapped_or_edited_shards_are_refused(tmp_path):
     """Issue 14 defect 5: shard 1 copied over shard 0 (npz + sidecar), or a sidecar's index, first
     sample, seed or statistics edited, is refused: each shard is bound to its place and content."""
