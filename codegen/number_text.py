@@ -12,8 +12,11 @@ from __future__ import annotations
 
 import re
 
-INTEGER = re.compile(r"[+-]?[0-9]+")
-REAL = re.compile(r"[+-]?(?:(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?|(?i:inf|infinity|nan))")
+from codegen.values import DECIMAL_TEXT, INTEGER_TEXT
+
+# the grammar of numbers in files (codegen.values), plus the words inf and nan that a flag may spell
+INTEGER = INTEGER_TEXT
+REAL = re.compile(rf"(?:{DECIMAL_TEXT.pattern})|[+-]?(?i:inf|infinity|nan)")
 BLANKS = " \t\r\n"
 
 
