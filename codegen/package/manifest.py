@@ -21,7 +21,7 @@ import stat
 from pathlib import Path
 
 from codegen.errors import CodegenError
-from codegen.package.config import NAME_PATTERN as NAME
+from codegen.names import name_problem
 
 FORMAT = "staregen.flight-package"
 VERSION = 1
@@ -134,7 +134,7 @@ def load(folder: str | Path) -> dict:
     if not isinstance(version, int) or isinstance(version, bool) or version != VERSION:
         raise PackageError(f"{path}: version: unsupported {version!r} (this staregen reads {VERSION})")
     name = doc.get("name")
-    if not isinstance(name, str) or not NAME.fullmatch(name):
+    if not isinstance(name, str) or name_problem(name):   # the one name rule (codegen.names)
         raise PackageError(f"{path}: name: not a package entry name")
     files = doc.get("files")
     if not isinstance(files, dict) or not files:
