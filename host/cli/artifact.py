@@ -4,8 +4,7 @@ from __future__ import annotations
 import argparse
 
 from codegen import artifact as art
-from host.cli.args import parse_int, shown
-from host.errors import HostError
+from host.cli.args import parse_int
 
 
 def register(subparsers) -> None:
@@ -29,29 +28,9 @@ def run_check(args: argparse.Namespace) -> int:
     return 0
 
 
-# What 1 MB of the STM32F417's flash holds as float32 weights: a bigger network cannot fly, and refusing
-# it here keeps `--shape 10000-10000-10000` from allocating gigabytes before anything is checked.
-MAX_WEIGHTS = 1 << 18
-
-
-def parse_shape(text: str) -> tuple[int, int, int]:
-    """--shape N_IN-N_HIDDEN-N_OUT: three integers in ASCII digits, each layer at most the artifact's
-    MAX_LAYER_SIZE, the weights and biases together at most MAX_WEIGHTS."""
-    parts = text.split("-")
-    if len(parts) != 3:
-        raise HostError(f"--shape: expected N_IN-N_HIDDEN-N_OUT (e.g. 12-40-3), got {shown(text)}")
-    n_in, n_hidden, n_out = (parse_int(p, "--shape: a layer size", minimum=1, maximum=art.MAX_LAYER_SIZE)
-                             for p in parts)
-    weights = n_hidden * (n_in + 1) + n_out * (n_hidden + 1)
-    if weights > MAX_WEIGHTS:
-        raise HostError(f"--shape {n_in}-{n_hidden}-{n_out}: {weights:,} weights and biases, more than the "
-                        f"{MAX_WEIGHTS:,} that fit in 1 MB of flash as float32")
-    return n_in, n_hidden, n_out
-
-
 def run_random(args: argparse.Namespace) -> int:
     seed = parse_int(args.seed, "--seed", maximum=2**32 - 1)
-    a = art.random_artifact(parse_shape(args.shape), seed)
+    a = art.random_artifact(art.parse_shape(args.shape), seed)   # refused before allocating
     path = a.save(args.out)
     print(f"wrote {path}: {a.shape_text}, seed {seed}, sha256 {a.sha256}")
     return 0

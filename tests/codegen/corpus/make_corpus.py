@@ -127,7 +127,7 @@ PARAMS = {
     "inertia_indefinite.toml": (lambda t: _set(t, "inertia", "[[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]]"),
                                 "'inertia' must be positive definite"),
     "string_value.toml": (lambda t: _set(t, "eta", '"0.1"'), "'eta' must be a finite number"),
-    "infinite.toml": (lambda t: _set(t, "eta", "inf"), "'eta' must be a finite number"),
+    "infinite.toml": (lambda t: _set(t, "eta", "inf"), "'eta': must be finite"),
     "duplicate.toml": (lambda t: t + "\nk1 = 1.0\n", "not valid TOML"),
     "bad_syntax.toml": (lambda t: t + "\n= 3\n", "not valid TOML"),
 }

@@ -203,7 +203,6 @@ CASES = [
     (["verify", "--artifact", "{net}", "--vectors", " \u0664 ", "--steps", "2"],
      "--vectors must be an integer in ASCII digits"),
     (["artifact", "random", "--shape", "\u0661\u0662-40-3", "--out", "{tmp}/a.json"], "--shape"),
-    (["artifact", "random", "--shape", "10000-10000-10000", "--out", "{tmp}/a.json"], "--shape 10000-10000-10000"),
     (["dp", "build", "--data", "{tmp}/none", "--n-max", "1_000", "--out", "{tmp}/t.json"], "--n-max"),
     # issue 25 (integrity)
     (["generate", "--config", "{cfg}", "--network", "{net}", "--out", "{tmp}/p", "--sign-key", "{file}"],

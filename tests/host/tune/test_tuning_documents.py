@@ -84,7 +84,7 @@ def test_json_the_tool_writes_is_strict(tmp_path):
 @pytest.mark.parametrize("text", ["[]", "5", "null", '"plan"'])
 def test_a_plan_file_that_is_not_an_object_is_a_one_line_error(tmp_path, text):
     (tmp_path / PLAN_FILE).write_text(text)
-    with pytest.raises(HostError, match=r"tuning\.json: unreadable tuning plan \(expected a JSON object, got list\)"):
+    with pytest.raises(HostError, match=r"tuning\.json: unreadable tuning plan \(expected a JSON object, got "):
         open_directory(tmp_path, _plan())
 
 
