@@ -82,6 +82,18 @@ def show_value(v) -> str:
     return values.show(v)
 
 
+def check_format_version(data: dict, fmt: str, version: int, error: type[Exception]) -> None:
+    """The `format` and integer `version` header every sealed TOML file of staregen starts with (the
+    controller configuration, the scenario file), each defect one `error` line."""
+    if data.get("format") != fmt:
+        raise error(f"format: must be \"{fmt}\", got {show_value(data.get('format'))}")
+    got = data.get("version")
+    if not isinstance(got, int) or isinstance(got, bool):
+        raise error(f"version: must be the integer {version}, got {show_value(got)}")
+    if got != version:
+        raise error(f"version: unsupported version {got} (this staregen reads version {version})")
+
+
 def _real(v, key: str, low: float | None = None, high: float | None = None, **ends) -> float:
     """The file's float64 value, after checking its float32 rounding (what the C holds) is in range."""
     values.float32_in(v, key, low, high, error=ConfigError, **ends)
@@ -132,13 +144,7 @@ def _check(data) -> dict:
     for key in data:
         if key not in TOP_KEYS:
             raise ConfigError(f"{key}: unknown key (known: {', '.join(TOP_KEYS)})")
-    if data.get("format") != FORMAT:
-        raise ConfigError(f"format: must be \"{FORMAT}\", got {show_value(data.get('format'))}")
-    version = data.get("version")
-    if not isinstance(version, int) or isinstance(version, bool):
-        raise ConfigError(f"version: must be the integer {VERSION}, got {show_value(version)}")
-    if version != VERSION:
-        raise ConfigError(f"version: unsupported version {version} (this staregen reads version {VERSION})")
+    check_format_version(data, FORMAT, VERSION, ConfigError)
     values = {}
     for table, keys in SCHEMA.items():
         got = data.get(table)

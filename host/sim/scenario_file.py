@@ -24,8 +24,7 @@ from pathlib import Path
 from codegen import atomic, reading
 # the controller configuration's canonical form (reals as float.hex) and value display: one
 # definition of "the same values" and of a one-line shown value across the sealed files
-from codegen.package.config import canonical_form
-from codegen.package.config import show_value as show
+from codegen.package.config import canonical_form, check_format_version, show_value as show
 from host.core.constants import ARCSEC
 from host.errors import HostError
 from host.plant.error_model import DEG_PER_HOUR, ErrorModel, ErrorSource
@@ -228,13 +227,7 @@ def _check_header(data: dict) -> None:
     for key in ("format", "version", "reading"):
         if key not in data:
             raise ScenarioError(f"{key}: missing key")
-    if data.get("format") != FORMAT:
-        raise ScenarioError(f"format: must be \"{FORMAT}\", got {show(data.get('format'))}")
-    version = data.get("version")
-    if not isinstance(version, int) or isinstance(version, bool):
-        raise ScenarioError(f"version: must be the integer {VERSION}, got {show(version)}")
-    if version != VERSION:
-        raise ScenarioError(f"version: unsupported version {version} (this staregen reads version {VERSION})")
+    check_format_version(data, FORMAT, VERSION, ScenarioError)
     reading = data.get("reading")
     if not isinstance(reading, str) or not READING_PATTERN.fullmatch(reading):
         raise ScenarioError(f"reading: must be a name of 1-40 characters a-z, 0-9, _ or - "
