@@ -15,13 +15,12 @@ from pathlib import Path
 import pytest
 
 from codegen import atomic
-from codegen.artifact import random_artifact
 from codegen.package import manifest
-from host.cli import main
 from host.errors import HostError
 from host.tune.pid_tuning import PLAN_FILE, TuningPlan, open_directory
 from host.tune.pid_grid import PidGrid
 from host.sim.targets import staring_targets
+from tests.host.cli.package_inputs import cli, package_inputs
 
 ROOT = Path(__file__).resolve().parents[3]
 SMALL = ["--gate-vectors", "1000", "--vectors", "32", "--cycles-per-class", "3"]
@@ -41,20 +40,11 @@ tp.build_package(sys.argv[1], cfg.name, units, cfg.to_mapping(), {}, plan, log=l
 """
 
 
-def cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 @pytest.fixture()
 def inputs(tmp_path):
     folder = tmp_path / "in"
     folder.mkdir()
-    cfg, net = folder / "controller.toml", folder / "network.json"
-    assert main(["config", "init", "--out", str(cfg)]) == 0
-    random_artifact((12, 40, 3), seed=2).save(net)
-    return cfg, net
+    return package_inputs(folder)
 
 
 def generate(capsys, inputs, out, *extra):

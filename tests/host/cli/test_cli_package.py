@@ -4,24 +4,14 @@ from __future__ import annotations
 
 import pytest
 
-from codegen.artifact import random_artifact
-from host.cli import main
+from tests.host.cli.package_inputs import cli, package_inputs
 
 SMALL = ["--gate-vectors", "1000", "--vectors", "32", "--cycles-per-class", "3"]
 
 
-def cli(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 @pytest.fixture()
 def inputs(tmp_path):
-    cfg, net = tmp_path / "controller.toml", tmp_path / "network.json"
-    assert main(["config", "init", "--out", str(cfg)]) == 0
-    random_artifact((12, 40, 3), seed=2).save(net)
-    return cfg, net
+    return package_inputs(tmp_path)
 
 
 def test_config_init_check_seal(tmp_path, capsys, inputs):

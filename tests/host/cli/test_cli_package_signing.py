@@ -10,25 +10,15 @@ import re
 
 import pytest
 
-from codegen.artifact import random_artifact
 from codegen.package import manifest
-from host.cli import main
+from tests.host.cli.package_inputs import cli, package_inputs
 
 SMALL = ["--gate-vectors", "100", "--vectors", "8", "--cycles-per-class", "1"]
 
 
-def cli(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
 @pytest.fixture()
 def inputs(tmp_path):
-    cfg, net = tmp_path / "controller.toml", tmp_path / "network.json"
-    assert main(["config", "init", "--out", str(cfg)]) == 0
-    random_artifact((12, 40, 3), seed=2).save(net)
-    return cfg, net
+    return package_inputs(tmp_path)
 
 
 def reseal(folder, edit=None, drop_signature=False) -> None:
