@@ -245,10 +245,13 @@ class UnitKind:
     `configure(**inputs)` receives the keyword inputs the CLI or a caller has (artifact=,
     params=, period=, config=, scenario=, name=), takes those it needs and refuses a missing one
     with a CodegenError. `example()` gives small inputs for the tests written once for every
-    unit (tests/codegen/units/test_every_unit.py): registering a unit is what gets it tested."""
+    unit (tests/codegen/units/test_every_unit.py): registering a unit is what gets it tested.
+    `load_params(path)` reads and validates the unit's own parameter file (units that need
+    `params`); its errors are one-line CodegenErrors."""
 
     name: str
     summary: str
     needs: tuple[str, ...]
     configure: Callable[..., Unit]
     example: Callable[[], dict]
+    load_params: Callable[[object], object] | None = None

@@ -12,7 +12,6 @@ from codegen import units
 from codegen.names import name_problem, show
 from codegen.unit import Unit
 from codegen.units.dp import tables as dp_tables
-from codegen.units.tanh.params import load_params
 from host.cli.args import parse_number
 from host.errors import HostError
 from host.control.nn_controller import load_artifact
@@ -21,6 +20,7 @@ from host.sim.scenarios import configure_unit
 
 # the paper-000 example's parameters, found from any working directory
 PAPER000_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "tanh_paper000.toml"
+PAPER002_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "rbf_paper002.toml"
 
 
 def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network") -> None:
@@ -29,7 +29,7 @@ def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network"
                         help="generated unit: " + "; ".join(f"{k}: {v.summary}" for k, v in sorted(known.items()))
                         + f" (default {default})")
     parser.add_argument("--artifact", metavar="FILE", help="model artifact (units network, controller)")
-    parser.add_argument("--params", metavar="FILE", help="parameter file, .toml/.json (unit tanh)")
+    parser.add_argument("--params", metavar="FILE", help="the unit's parameter file, .toml/.json (units tanh, rbf)")
     parser.add_argument("--tables", metavar="FILE", help="discrete-point tables (unit dp; `staregen dp build`)")
     parser.add_argument("--period", default=None, metavar="S", help="control period baked into the unit, s "
                         "(unit tanh; default 0.1)")
@@ -58,7 +58,7 @@ def unit_from_args(args: argparse.Namespace) -> Unit:
             raise HostError(f"--period does not apply to unit {args.unit}")
         inputs["period"] = parse_number(args.period, "--period", positive=True)
     if args.params is not None:
-        inputs["params"] = load_params(args.params)
+        inputs["params"] = kind.load_params(args.params)
     if tables is not None:
         inputs["tables"] = dp_tables.load(tables)
     if args.artifact is not None:
@@ -75,6 +75,8 @@ def add_report_unit_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--artifact", metavar="FILE", help="network artifact (default: the stand-in network)")
     parser.add_argument("--params", metavar="FILE", default=str(PAPER000_PARAMS),
                         help="tanh parameters (default the paper-000 example, docs/tanh_paper000.toml)")
+    parser.add_argument("--rbf-params", metavar="FILE", default=str(PAPER002_PARAMS),
+                        help="rbf-law parameters (default paper 002's, docs/rbf_paper002.toml)")
 
 
 def report_units(args: argparse.Namespace) -> list[Unit]:
@@ -82,6 +84,8 @@ def report_units(args: argparse.Namespace) -> list[Unit]:
     others to their examples."""
     network = art.load(args.artifact) if args.artifact else load_artifact(None)
     inputs = {"network": {"artifact": network}, "controller": {"artifact": network},
-              "tanh": {"params": load_params(args.params)}}
+              "tanh": {"params": units.get("tanh").load_params(args.params)}}
+    if "rbf" in units.kinds():
+        inputs["rbf"] = {"params": units.get("rbf").load_params(args.rbf_params)}
     kinds = sorted(units.kinds()) if args.unit == "all" else [args.unit]
     return [configure_unit(kind, **inputs.get(kind, units.get(kind).example())) for kind in kinds]
