@@ -226,6 +226,11 @@ class Unit(ABC):
         """Unit-specific figures for the cycle report (e.g. the controller without its network)."""
         return {}
 
+    def values_sha256(self) -> str | None:
+        """sha256 of the values the C bakes in from the unit's parameter file (with the control
+        period), recorded in a package's manifest; None for units without one."""
+        return None
+
     # ------------------------------------------------------------------ interface documentation
     def field_docs(self) -> dict[str, list[FieldDoc]]:
         """{"input": [...], "output": [...], "state": [...]}: every dtype field with unit, frame and

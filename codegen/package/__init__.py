@@ -8,8 +8,8 @@
       ICD.md           interface control document
       manifest.json    sha256 of every file and input, flags, compiler, measured evidence
 
-The controller unit's entry is <name> (<name>_init, <name>_step); the tanh law, when the
-configuration includes it, is <name>_tanh. `int <name>_selftest(void)` returns the number of
+The controller unit's entry is <name> (<name>_init, <name>_step); every other unit the
+configuration includes (the tanh law, the RBF law) is <name>_<unit>. `int <name>_selftest(void)` returns the number of
 mismatching 32-bit words over every embedded vector of every unit plus failed floating-point
 environment checks (0 = pass); `<name>_selftest_reference(&state, &input)` gives the controller's
 timing reference step (vector 0), whose cycles the manifest records.

@@ -19,11 +19,11 @@ from pathlib import Path
 from codegen import atomic, reading, values
 from codegen.errors import CodegenError
 from codegen.names import NAME, name_problem
+from codegen import units as unit_registry
 from codegen.units.controller.spec import ControllerConfig
 
 FORMAT = "staregen.controller-config"
 VERSION = 1
-KNOWN_UNITS = ("controller", "tanh")
 NAME_PATTERN = NAME     # the one package-name rule: codegen.names
 MAX_DWELL = 1_000_000
 MAX_PERIOD_S = 10.0
@@ -38,6 +38,13 @@ SCHEMA: dict[str, dict[str, str]] = {
     "earth": {"a": ">0", "e2": "[0,1)", "rate": ">0", "mu": ">0"},
 }
 TOP_KEYS = ("format", "version", "sha256", *SCHEMA)
+
+
+def known_units() -> tuple[str, ...]:
+    """"controller" (required) and every registered unit that reads its own parameter file: the
+    package binds those to `generate --params UNIT=FILE` at the configuration's control period."""
+    kinds = unit_registry.kinds()
+    return ("controller",) + tuple(sorted(k for k, kind in kinds.items() if kind.load_params is not None))
 
 
 class ConfigError(CodegenError):
@@ -56,8 +63,9 @@ class PackageConfig:
         _check(self.to_mapping())
 
     @property
-    def has_tanh(self) -> bool:
-        return "tanh" in self.units
+    def param_units(self) -> tuple[str, ...]:
+        """The units besides the controller (each needs its parameter file)."""
+        return tuple(u for u in self.units if u != "controller")
 
     def to_mapping(self) -> dict:
         """The file's values as nested tables (without the seal)."""
@@ -110,14 +118,15 @@ def _value(kind: str, v, key: str):
     if kind == "units":
         if not isinstance(v, list) or not all(isinstance(u, str) for u in v):
             raise ConfigError(f"{key}: must be a list of unit names, got {show_value(v)}")
+        known = known_units()
         for u in v:
-            if u not in KNOWN_UNITS:
-                raise ConfigError(f"{key}: unknown unit {show_value(u)} (known: {', '.join(KNOWN_UNITS)})")
+            if u not in known:
+                raise ConfigError(f"{key}: unknown unit {show_value(u)} (known: {', '.join(known)})")
         if len(set(v)) != len(v):
             raise ConfigError(f"{key}: lists a unit twice")
         if "controller" not in v:
             raise ConfigError(f"{key}: must include \"controller\" (the package's main unit)")
-        return tuple(u for u in KNOWN_UNITS if u in v)
+        return tuple(u for u in known if u in v)
     if kind == "int>=1":
         return values.integer_in(v, key, 1, MAX_DWELL, ConfigError)
     if kind == "vec3>=0":
@@ -262,8 +271,9 @@ sha256 = "{cfg.sha256}"
 [package]
 # Entry-name prefix: {cfg.name}_init / {cfg.name}_step / {cfg.name}_selftest, files {cfg.name}*.h/.c.
 name = "{cfg.name}"
-# Units in the package: "controller" (Fig. 2 with its network; required), "tanh" (the tanh
-# saturation law of paper 000, entry {cfg.name}_tanh; needs `generate --tanh PARAMS`).
+# Units in the package: "controller" (Fig. 2 with its network; required) and any of
+# {", ".join(f'"{u}"' for u in known_units()[1:])} (entry {cfg.name}_<unit>; each needs
+# `generate --params <unit>=FILE`, e.g. "tanh": paper 000's tanh law, docs/tanh_paper000.toml).
 units = [{units}]
 
 [pid]

@@ -205,7 +205,7 @@ def unit_context(name: str, kind: str, unit: Unit, ev: dict, clock: int, budget:
 
 
 def render_icd(name: str, units: dict[str, Unit], config: dict, evidence: dict, flags: dict) -> str:
-    """ICD.md of the package `name`: units {"controller": ..., optionally "tanh": ...} bound to the
+    """ICD.md of the package `name`: units {"controller": ..., and any configured "tanh", "rbf", ...} bound to the
     configuration `config` (the configuration file's mapping, plus "inputs": {role: {"file",
     "sha256"}}), `evidence` as tools/package.py measures it ({"units": {kind: {...}}, "clock_hz",
     "paper_budget_cycles", optionally "package_build"}), `flags` {"common", "arm_cpu",

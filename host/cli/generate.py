@@ -1,8 +1,9 @@
-"""`staregen generate --config controller.toml --network network.json [--tanh params.toml] --out DIR`:
+"""`staregen generate --config controller.toml --network network.json [--params UNIT=FILE ...] --out DIR`:
 the flight package (sources, self-test, CMakeLists, ICD, manifest with the evidence).
 
-The configuration and the network (and the tanh parameters when the configuration includes the
-tanh law) are validated before anything is generated; the package folder appears only when
+The configuration and the network (and the parameter file of every other unit the configuration
+includes: `--params tanh=docs/tanh_paper000.toml`, `--params rbf=docs/rbf_paper002.toml`) are
+validated before anything is generated; the package folder appears only when
 complete, and only when the gate and the self-test on x86 and ARM found no mismatch.
 """
 from __future__ import annotations
@@ -13,11 +14,10 @@ from pathlib import Path
 
 from codegen import artifact as art
 from codegen import reading
+from codegen import units as unit_registry
 from codegen.package import config as pc
 from codegen.package.manifest import load_key
 from codegen.package.selftest import MAX_VECTORS
-from codegen.units.tanh.emit import params_sha256
-from codegen.units.tanh.params import load_params
 from host.cli.args import parse_int
 from host.errors import HostError
 from host.outputs import check_output_folder, package_owner
@@ -31,8 +31,10 @@ def register(subparsers) -> None:
                               description=__doc__.splitlines()[0])
     p.add_argument("--config", required=True, metavar="FILE", help="controller configuration (staregen config init)")
     p.add_argument("--network", required=True, metavar="FILE", help="network artifact (e.g. out/pipeline/network.json)")
-    p.add_argument("--tanh", default=None, metavar="FILE", help="tanh-law parameter file (when the configuration "
-                   "includes the tanh unit)")
+    p.add_argument("--params", action="append", default=[], metavar="UNIT=FILE",
+                   help="parameter file of a unit the configuration includes besides the controller (repeat per unit; "
+                   f"units: {', '.join(pc.known_units()[1:])})")
+    p.add_argument("--tanh", default=None, metavar="FILE", help="shorthand for --params tanh=FILE")
     p.add_argument("--out", required=True, metavar="DIR", help="package folder (new or empty, or replaced if it holds "
                    "exactly a staregen package)")
     p.add_argument("--sign-key", default=None, metavar="FILE", help="key file (at least 32 random bytes, kept by "
@@ -67,13 +69,31 @@ def file_sha256(path: Path) -> str:
         raise HostError(str(exc)) from None
 
 
-def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, tanh=None,
+def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, params: dict | None = None,
              plan: EvidencePlan = EvidencePlan(), log=print, input_paths=(), sign_key: bytes | None = None):
     """The package of a validated configuration and network (also the pipeline's last stage);
-    `input_paths`: the files read, which must not lie in the folder it replaces."""
+    `params`: {unit: its parameters}; `input_paths`: the files read, which must not lie in the
+    folder it replaces."""
     check_output_folder(out, package_owner, input_paths)
-    units = package_units(cfg, network, tanh)
+    units = package_units(cfg, network, params)
     return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log, sign_key)
+
+
+def parameter_files(args: argparse.Namespace) -> dict[str, Path]:
+    """{unit: path} of --params UNIT=FILE (and --tanh FILE); one line for a bad or repeated unit."""
+    pairs = list(args.params) + ([f"tanh={args.tanh}"] if args.tanh is not None else [])
+    known = pc.known_units()[1:]
+    files: dict[str, Path] = {}
+    for pair in pairs:
+        unit, sep, path = pair.partition("=")
+        if not sep or not path:
+            raise HostError(f"--params: expected UNIT=FILE, got {pair[:60]!r}")
+        if unit not in known:
+            raise HostError(f"--params: unknown unit {unit[:40]!r} (units with a parameter file: {', '.join(known)})")
+        if unit in files:
+            raise HostError(f"--params: unit {unit} given twice")
+        files[unit] = Path(path)
+    return files
 
 
 def summary(result) -> list[str]:
@@ -92,16 +112,16 @@ def run(args: argparse.Namespace) -> int:
     sign_key = load_key(args.sign_key) if args.sign_key is not None else None
     cfg = pc.load(args.config)
     network = art.load(args.network)
-    tanh = load_params(args.tanh) if args.tanh is not None else None
+    files = parameter_files(args)
+    params = {unit: unit_registry.get(unit).load_params(path) for unit, path in files.items()}
     config_path, network_path = Path(args.config), Path(args.network)
     inputs = {"config": {"file": config_path.name, "sha256": file_sha256(config_path), "values_sha256": cfg.sha256},
               "network": {"file": network_path.name, "sha256": file_sha256(network_path),
                           "payload_sha256": network.sha256, "shape": network.shape_text}}
-    if tanh is not None:
-        tanh_path = Path(args.tanh)
-        inputs["tanh"] = {"file": tanh_path.name, "sha256": file_sha256(tanh_path),
-                          "values_sha256": params_sha256(tanh, cfg.controller.control_period)}
-    result = generate(cfg, network, Path(args.out), inputs, tanh, plan,
-                      input_paths=(args.config, args.network, args.tanh, args.sign_key), sign_key=sign_key)
+    bound = package_units(cfg, network, params)      # refuses a missing or unconfigured unit before any work
+    for unit, path in files.items():
+        inputs[unit] = {"file": path.name, "sha256": file_sha256(path), "values_sha256": bound[unit].values_sha256()}
+    result = generate(cfg, network, Path(args.out), inputs, params, plan,
+                      input_paths=(args.config, args.network, *files.values(), args.sign_key), sign_key=sign_key)
     print("\n".join(summary(result)))
     return 0

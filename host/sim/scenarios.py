@@ -139,17 +139,20 @@ class Paper000ClosedLoop:
         return {"example": example_records(unit.params, unit.period)}
 
 
-def package_units(cfg: PackageConfig, artifact, tanh_params=None) -> dict[str, Unit]:
+def package_units(cfg: PackageConfig, artifact, params: dict | None = None) -> dict[str, Unit]:
     """The units of a flight package bound to its configuration: the controller `<name>` flying
-    the network, and the tanh law `<name>_tanh` at the same control period when configured."""
+    the network, and each other configured unit `<name>_<unit>` bound to its parameters
+    (`params[unit]`) at the same control period."""
+    params = dict(params or {})
     units = {"controller": configure_unit("controller", artifact=artifact, config=cfg.controller, name=cfg.name)}
-    if cfg.has_tanh:
-        if tanh_params is None:
-            raise HostError("the configuration's units include \"tanh\": give its parameter file with --tanh")
-        units["tanh"] = configure_unit("tanh", params=tanh_params, period=cfg.controller.control_period,
-                                       name=f"{cfg.name}_tanh")
-    elif tanh_params is not None:
-        raise HostError("--tanh given, but the configuration's [package] units do not include \"tanh\"")
+    for kind in cfg.param_units:
+        if kind not in params:
+            raise HostError(f"the configuration's units include \"{kind}\": give its parameter file with "
+                            f"--params {kind}=FILE")
+        units[kind] = configure_unit(kind, params=params.pop(kind), period=cfg.controller.control_period,
+                                     name=f"{cfg.name}_{kind}")
+    for kind in params:
+        raise HostError(f"--params {kind}=FILE given, but the configuration's [package] units do not include \"{kind}\"")
     return units
 
 

@@ -26,7 +26,7 @@ ARTIFACT = random_artifact((12, 40, 3), seed=1)
 
 def generate(out: Path, cfg=None, tanh=None):
     cfg = cfg or default_package_config()
-    units = package_units(cfg, ARTIFACT, tanh)
+    units = package_units(cfg, ARTIFACT, {"tanh": tanh} if tanh is not None else None)
     return build_package(out, cfg.name, units, cfg.to_mapping(), {"network": {"sha256": ARTIFACT.sha256}},
                          PLAN, log=lambda _line: None)
 

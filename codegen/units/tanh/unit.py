@@ -33,6 +33,9 @@ class TanhUnit(Unit):
         return f"tanh law ({self.step_symbol}), period {self.period:g} s, params sha256 " \
                f"{params_sha256(self.params, self.period)[:16]}"
 
+    def values_sha256(self) -> str:
+        return params_sha256(self.params, self.period)
+
     def sources(self) -> dict[str, str]:
         return dict(self._sources)
 

@@ -56,6 +56,17 @@ def test_tanh_file_must_match_the_configuration(tmp_path, capsys, inputs):
     assert code == 2 and "do not include \"tanh\"" in err
 
 
+def test_a_configured_unit_without_its_parameter_file_is_one_line(tmp_path, capsys, inputs):
+    cfg, net = inputs
+    cfg.write_text(cfg.read_text().replace('units = ["controller"]', 'units = ["controller", "tanh"]'))
+    assert cli(capsys, "config", "seal", str(cfg))[0] == 0
+    out = tmp_path / "pkg"
+    code, _, err = cli(capsys, "generate", "--config", str(cfg), "--network", str(net), "--out", str(out), *SMALL)
+    assert code == 2 and err.count("\n") == 1
+    assert "units include \"tanh\": give its parameter file with --params tanh=FILE" in err
+    assert not out.exists()
+
+
 def test_generate_then_check(tmp_path, capsys, inputs):
     cfg, net = inputs
     out = tmp_path / "pkg"
