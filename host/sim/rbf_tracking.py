@@ -198,6 +198,8 @@ def metrics_of(hist: dict[str, np.ndarray], accuracy_from: float = ACCURACY_FROM
         "weight_bound_active_steps": int(np.count_nonzero(hist["status"][ctrl] & STATUS_WEIGHT_BOUND)),
         "rms_w_error": np.sqrt(np.mean(err ** 2, axis=0)).tolist(),
         "rms_w_true": np.sqrt(np.mean(hist["w_true"][ctrl] ** 2, axis=0)).tolist(),
+        "min_rho": float(np.min(hist["los"][:, 0])),
+        "t_min_rho": float(t[int(np.argmin(hist["los"][:, 0]))]),
         "finite": bool(np.all(np.isfinite(e1)) and np.all(np.isfinite(hist["force"][ctrl]))),
         "duration": float(t[-1]),
     }
@@ -207,17 +209,22 @@ def metrics_of(hist: dict[str, np.ndarray], accuracy_from: float = ACCURACY_FROM
             "rms_e1": np.sqrt(np.mean(e1[window] ** 2, axis=0)).tolist(),
             "max_abs_e1": np.max(np.abs(e1[window]), axis=0).tolist(),
             "rms_w_error_window": np.sqrt(np.mean(err_window ** 2, axis=0)).tolist() if len(err_window) else None,
+            # the period-2 limit cycle of the sampled sig(z)^alpha terms: half the step-to-step force change
+            "force_chatter_rms": float(np.sqrt(np.mean((0.5 * np.diff(hist["force"][ctrl][window[ctrl]], axis=0)) ** 2))),
+            "force_mean_norm": float(np.linalg.norm(np.mean(hist["force"][ctrl][window[ctrl]], axis=0))),
+            "delta_v_window": float(np.sum(np.abs(hist["force_applied"][ctrl][window[ctrl]])) * T
+                                    / float(hist["mass_truth"])),
         })
     return out
 
 
-def run(theorem: int, duration: float = 1000.0, **overrides) -> dict:
-    """The paper-length run of one theorem with paper_params(); metrics, wall time and the history."""
+def run(theorem: int, duration: float = 1000.0, period: float = PERIOD, **overrides) -> dict:
+    """The paper-length run of one theorem with paper_params(**overrides); metrics, wall time, history."""
     params = paper_params(theorem=theorem, **overrides)
     start = time.perf_counter()
-    hist = simulate(params, duration)
+    hist = simulate(params, duration, period=period)
     metrics = metrics_of(hist)
-    metrics.update({"theorem": theorem, "wall_time_s": round(time.perf_counter() - start, 2)})
+    metrics.update({"theorem": theorem, "period": period, "wall_time_s": round(time.perf_counter() - start, 2)})
     return {"metrics": metrics, "history": hist}
 
 
