@@ -209,6 +209,7 @@ def metrics_of(hist: dict[str, np.ndarray], accuracy_from: float = ACCURACY_FROM
             "rms_e1": np.sqrt(np.mean(e1[window] ** 2, axis=0)).tolist(),
             "max_abs_e1": np.max(np.abs(e1[window]), axis=0).tolist(),
             "rms_w_error_window": np.sqrt(np.mean(err_window ** 2, axis=0)).tolist() if len(err_window) else None,
+            "rms_w_true_window": np.sqrt(np.mean(hist["w_true"][ctrl][window[ctrl]] ** 2, axis=0)).tolist(),
             # the period-2 limit cycle of the sampled sig(z)^alpha terms: half the step-to-step force change
             "force_chatter_rms": float(np.sqrt(np.mean((0.5 * np.diff(hist["force"][ctrl][window[ctrl]], axis=0)) ** 2))),
             "force_mean_norm": float(np.linalg.norm(np.mean(hist["force"][ctrl][window[ctrl]], axis=0))),
