@@ -177,6 +177,11 @@ def time_to_stay_within(t: np.ndarray, err: np.ndarray, band: float) -> float | 
     return None if last == len(t) - 1 else float(t[last + 1])
 
 
+def _last_time(t: np.ndarray, flags: np.ndarray) -> float | None:
+    hits = np.nonzero(flags)[0]
+    return float(t[hits[-1]]) if hits.size else None
+
+
 def metrics_of(hist: dict[str, np.ndarray], accuracy_from: float = ACCURACY_FROM) -> dict:
     t, e1, T = hist["t"], hist["e1"], float(hist["period"])
     ctrl = slice(0, len(t) - 1)                        # rows with a command (the last row has none)
@@ -196,6 +201,7 @@ def metrics_of(hist: dict[str, np.ndarray], accuracy_from: float = ACCURACY_FROM
         "max_abs_theta_delta": float(np.nanmax(hist["theta_delta_abs_max"])),
         "max_abs_theta_per_channel": np.nanmax(hist["theta_abs_max"], axis=0).tolist(),
         "weight_bound_active_steps": int(np.count_nonzero(hist["status"][ctrl] & STATUS_WEIGHT_BOUND)),
+        "t_last_weight_bound": _last_time(t[ctrl], hist["status"][ctrl] & STATUS_WEIGHT_BOUND),
         "rms_w_error": np.sqrt(np.mean(err ** 2, axis=0)).tolist(),
         "rms_w_true": np.sqrt(np.mean(hist["w_true"][ctrl] ** 2, axis=0)).tolist(),
         "min_rho": float(np.min(hist["los"][:, 0])),

@@ -10,7 +10,7 @@ from host.control.rbf_law import STATUS_INVALID_INPUT, RbfLaw, paper_params
 from host.core.constants import DEG
 from host.core.rotations import los_frame
 from host.gnc.los import measure
-from host.plant.proximity import MU_EARTH, ProximityPlant, relative_state
+from host.plant.proximity import MU_EARTH, ProximityPlant
 from host.sim import rbf_tracking as rt
 
 DURATION = 80.0
