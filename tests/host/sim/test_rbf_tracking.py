@@ -80,3 +80,12 @@ def test_record_controller_flies_the_same_loop():
     via_records = rt.simulate(p, 15.0, controller=rt.record_controller(RbfLaw(p).step_record))
     np.testing.assert_allclose(via_records["e1"][:, 0], ref["e1"][:, 0], atol=0.05)
     np.testing.assert_allclose(via_records["e1"][:, 3:], ref["e1"][:, 3:], atol=2e-3)
+
+
+@pytest.mark.parametrize("kwargs", [{"duration": -1.0}, {"duration": float("nan")}, {"duration": 10.0, "dt": 0.5},
+                                    {"duration": 10.0, "dt": 0.0}])
+def test_bad_run_settings_are_one_line_host_errors(kwargs):
+    from host.errors import HostError
+    with pytest.raises(HostError) as info:
+        rt.simulate(paper_params(), **kwargs)
+    assert "\n" not in str(info.value)
