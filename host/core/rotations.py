@@ -206,3 +206,60 @@ def project_to_so3(M) -> np.ndarray:
     D = np.eye(3)
     D[2, 2] = np.sign(np.linalg.det(U @ Vt))
     return U @ D @ Vt
+
+
+# ----------------------------------------------------------------------------- Euler 3-1-2 kinematics (paper 002)
+# Paper 002 uses the same order as paper 001 (C_bi = Ry(theta) Rx(phi) Rz(psi)); its eq. (4)-(6) relate the
+# body rate to the Euler-angle rates through R(phi, theta) (docs/rbf-backstepping.md section 2).
+
+
+def euler312_rate_matrix(phi, theta) -> np.ndarray:
+    """R(phi, theta) with omega = R @ [phi_dot, theta_dot, psi_dot] (body rate, body axes); det R = cos(phi).
+
+    Why this form: omega = theta_dot*y + Ry(theta)(phi_dot*x) + Ry(theta)Rx(phi)(psi_dot*z).
+    """
+    phi, theta = np.asarray(phi, dtype=float), np.asarray(theta, dtype=float)
+    cp, sp, ct, st = np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta)
+    o, z = np.ones_like(cp), np.zeros_like(cp)
+    return _stack33([(ct, z, -st * cp), (z, o, sp), (st, z, ct * cp)])
+
+
+def euler312_rate_matrix_inverse(phi, theta) -> np.ndarray:
+    """R^-1 (Euler-angle rates from the body rate); singular at |phi| = pi/2."""
+    phi, theta = np.asarray(phi, dtype=float), np.asarray(theta, dtype=float)
+    cp, tp, ct, st = np.cos(phi), np.tan(phi), np.cos(theta), np.sin(theta)
+    o, z = np.ones_like(cp), np.zeros_like(cp)
+    return _stack33([(ct, z, st), (st * tp, o, -ct * tp), (-st / cp, z, ct / cp)])
+
+
+def euler312_rate_matrix_dot(phi, theta, phi_dot, theta_dot) -> np.ndarray:
+    """d/dt R(phi, theta) along a motion with Euler rates phi_dot, theta_dot (psi does not enter R)."""
+    phi, theta = np.asarray(phi, dtype=float), np.asarray(theta, dtype=float)
+    pd, td = np.asarray(phi_dot, dtype=float), np.asarray(theta_dot, dtype=float)
+    cp, sp, ct, st = np.cos(phi), np.sin(phi), np.cos(theta), np.sin(theta)
+    z = np.zeros(np.broadcast(cp, pd, td).shape)
+    return _stack33([(-st * td, z, -ct * cp * td + st * sp * pd),
+                     (z, z, cp * pd),
+                     (ct * td, z, -st * cp * td - ct * sp * pd)])
+
+
+# ----------------------------------------------------------------------------- line-of-sight frame (paper 002)
+
+
+def los_frame(q_eps, q_beta) -> np.ndarray:
+    """C_li = Rz(q_eps) Ry(q_beta): inertial -> LOS; x_l along the LOS, y_l in the plane of x_l and y_i.
+
+    Row 0 (x_l in inertial axes) = [c(q_eps) c(q_beta), s(q_eps), -c(q_eps) s(q_beta)].
+    """
+    return frame_rot_z(q_eps) @ frame_rot_y(q_beta)
+
+
+def los_angles(r) -> np.ndarray:
+    """[rho, q_eps, q_beta] of a relative position r (inertial axes): rho = |r|, q_eps = asin(y/rho)
+    (elevation, [-pi/2, pi/2]), q_beta = atan2(-z, x) (azimuth, [-pi, pi]); the inverse of
+    r = rho * los_frame(q_eps, q_beta)[0]."""
+    r = np.asarray(r, dtype=float)
+    rho = np.linalg.norm(r, axis=-1)
+    q_eps = np.arcsin(np.clip(r[..., 1] / rho, -1.0, 1.0))
+    q_beta = np.arctan2(-r[..., 2], r[..., 0])
+    return np.stack([rho, q_eps, q_beta], -1)

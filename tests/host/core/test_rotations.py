@@ -106,3 +106,52 @@ def test_project_to_so3():
     np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-14)
     assert np.linalg.det(R) == pytest.approx(1.0, abs=1e-14)
     assert np.max(np.abs(R - Rc0)) < 1e-3
+
+
+# ----------------------------------------------------------------------------- paper 002: 3-1-2 kinematics, LOS frame
+
+
+def _body_rate_from_dcm_motion(A, A_dot, h=1e-6):
+    """omega (body axes) from C_dot = -[omega]x C by central differences of dcm_from_euler312."""
+    C = rot.dcm_from_euler312(A)
+    C_dot = (rot.dcm_from_euler312(A + h * A_dot) - rot.dcm_from_euler312(A - h * A_dot)) / (2 * h)
+    return rot.vee(-C_dot @ np.swapaxes(C, -1, -2))
+
+
+def test_euler312_rate_matrix_against_finite_differences():
+    A = random_euler312(200)
+    A_dot = RNG.normal(size=(200, 3))
+    R = rot.euler312_rate_matrix(A[:, 0], A[:, 1])
+    np.testing.assert_allclose((R @ A_dot[..., None])[..., 0], _body_rate_from_dcm_motion(A, A_dot), atol=2e-8)
+
+
+def test_euler312_rate_matrix_inverse_and_determinant():
+    A = random_euler312(200)
+    R = rot.euler312_rate_matrix(A[:, 0], A[:, 1])
+    R_inv = rot.euler312_rate_matrix_inverse(A[:, 0], A[:, 1])
+    np.testing.assert_allclose(R_inv @ R, np.broadcast_to(np.eye(3), R.shape), atol=1e-9)
+    np.testing.assert_allclose(np.linalg.det(R), np.cos(A[:, 0]), atol=1e-12)
+
+
+def test_euler312_rate_matrix_dot_against_finite_differences():
+    A = random_euler312(100)
+    A_dot = RNG.normal(size=(100, 3))
+    h = 1e-6
+    numeric = (rot.euler312_rate_matrix(A[:, 0] + h * A_dot[:, 0], A[:, 1] + h * A_dot[:, 1])
+               - rot.euler312_rate_matrix(A[:, 0] - h * A_dot[:, 0], A[:, 1] - h * A_dot[:, 1])) / (2 * h)
+    analytic = rot.euler312_rate_matrix_dot(A[:, 0], A[:, 1], A_dot[:, 0], A_dot[:, 1])
+    np.testing.assert_allclose(analytic, numeric, atol=1e-8)
+
+
+def test_los_frame_x_axis_along_the_vector_and_y_in_the_xl_yi_plane():
+    r = RNG.normal(size=(300, 3)) * [200.0, 50.0, 200.0]
+    rho, q_eps, q_beta = rot.los_angles(r).T
+    C = rot.los_frame(q_eps, q_beta)
+    np.testing.assert_allclose(rho, np.linalg.norm(r, axis=1), rtol=1e-15)
+    np.testing.assert_allclose(C[:, 0] * rho[:, None], r, atol=1e-10)          # x_l = r / rho
+    y_i = np.array([0.0, 1.0, 0.0])
+    # y_l is in span(x_l, y_i): the triple product vanishes; and it points to the +y_i side
+    np.testing.assert_allclose(np.einsum("ij,ij->i", np.cross(C[:, 0], y_i), C[:, 1]), 0.0, atol=1e-14)
+    assert np.all(C[:, 1] @ y_i > 0)
+    np.testing.assert_allclose(C @ np.swapaxes(C, -1, -2), np.broadcast_to(np.eye(3), C.shape), atol=1e-14)
+    np.testing.assert_allclose(np.linalg.det(C), 1.0, atol=1e-14)
