@@ -59,10 +59,11 @@ class LawOutput(NamedTuple):
 class RbfState:
     theta: np.ndarray          # (N, 6) weights of the network for w
     theta_delta: np.ndarray    # (N, 6) weights of the network for G Delta_u (theorem 2; zero under theorem 1)
+    command: np.ndarray        # (6,) last output (force/force_max, torque/torque_max): the second network's input
 
 
 def initial_state(p: RbfParams) -> RbfState:
-    return RbfState(np.zeros((p.nodes, 6)), np.zeros((p.nodes, 6)))
+    return RbfState(np.zeros((p.nodes, 6)), np.zeros((p.nodes, 6)), np.zeros(6))
 
 
 def sig(x, a):
@@ -146,6 +147,14 @@ def basis(p: RbfParams, e1: np.ndarray, e2: np.ndarray) -> np.ndarray:
     return np.exp(-d2 / (2.0 * p.sigma ** 2))
 
 
+def command_basis(p: RbfParams, phi: np.ndarray, command: np.ndarray) -> np.ndarray:
+    """phi_Delta_j = phi_j exp(-|u_prev - c_j 1|^2 / (2 sigma^2)): the same diagonal layout on the
+    18 inputs [e; u_prev] (docs section 7: G Delta_u depends on the command, which the first network
+    does not see)."""
+    d2 = np.sum((command[None, :] - p.centres()[:, None]) ** 2, axis=1)
+    return phi * np.exp(-d2 / (2.0 * p.sigma ** 2))
+
+
 # ----------------------------------------------------------------------------- step 6: F, G, the law
 
 
@@ -214,11 +223,12 @@ def invalid_output() -> LawOutput:
 def step(p: RbfParams, state: RbfState, m: LosMeasurement, period: float = PERIOD) -> tuple[LawOutput, RbfState]:
     """One control period (section 11, steps 1-8)."""
     if not valid_input(p, m):
-        return invalid_output(), state
+        return invalid_output(), RbfState(state.theta, state.theta_delta, np.zeros(6))   # the command was 0
     t = tracking_terms(p, m)
     phi = basis(p, t.e1, t.e2)
+    phi_delta = command_basis(p, phi, state.command)
     w_hat = state.theta.T @ phi
-    w_hat_delta = state.theta_delta.T @ phi if p.theorem == 2 else np.zeros(6)
+    w_hat_delta = state.theta_delta.T @ phi_delta if p.theorem == 2 else np.zeros(6)
     F, _ = nominal_model(p, m, t)
     v = control_vector(p, F, t, w_hat + w_hat_delta)
     _, force, torque = commands(p, m, v)
@@ -232,14 +242,15 @@ def step(p: RbfParams, state: RbfState, m: LosMeasurement, period: float = PERIO
     theta, hit = adapt(p, state.theta, phi, t.z, p.gamma, period)
     theta_delta = state.theta_delta
     if p.theorem == 2:
-        theta_delta, hit_delta = adapt(p, state.theta_delta, phi, t.z, p.gamma_delta, period)
+        theta_delta, hit_delta = adapt(p, state.theta_delta, phi_delta, t.z, p.gamma_delta, period)
         hit = hit or hit_delta
     if hit:
         status |= STATUS_WEIGHT_BOUND
     if not (np.all(np.isfinite(force)) and np.all(np.isfinite(torque)) and np.all(np.isfinite(theta))
             and np.all(np.isfinite(theta_delta))):
-        return invalid_output(), state
-    return LawOutput(force, torque, w_hat, status), RbfState(theta, theta_delta)
+        return invalid_output(), RbfState(state.theta, state.theta_delta, np.zeros(6))
+    command = np.concatenate([force / p.force_max, torque / p.torque_max])
+    return LawOutput(force, torque, w_hat, status), RbfState(theta, theta_delta, command)
 
 
 class RbfLaw:

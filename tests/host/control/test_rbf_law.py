@@ -156,6 +156,29 @@ def test_weights_stay_within_their_bound_and_the_bound_is_reported():
     np.testing.assert_allclose(theta2, (1 - 0.1 * p.lam) * theta + 0.1 * 0.5e-3, rtol=1e-15)
 
 
+def test_the_second_network_sees_the_last_command():
+    """Theorem 2's basis is phi_j times a Gaussian of the previous command: equal to phi_j when the
+    command sits on the node's centre, smaller elsewhere; so theta_Delta learns apart from theta."""
+    p = law.paper_params(theorem=2)
+    phi = np.linspace(0.1, 0.9, p.nodes)
+    c = p.centres()
+    for j in range(p.nodes):
+        on_centre = law.command_basis(p, phi, np.full(6, c[j]))
+        assert on_centre[j] == phi[j]
+        others = [k for k in range(p.nodes) if k != j]
+        expected = phi[others] * np.exp(-6 * (c[j] - c[others]) ** 2 / (2 * p.sigma ** 2))
+        np.testing.assert_allclose(on_centre[others], expected, rtol=1e-14)
+    tau0 = 37.0
+    m = _measurement(_state_at(tau0), tau0)
+    state = law.initial_state(p)
+    for _ in range(20):
+        out, state = law.step(p, state, m)
+    np.testing.assert_array_equal(state.command, np.concatenate([out.force / p.force_max, out.torque / p.torque_max]))
+    assert np.max(np.abs(state.theta_delta - state.theta)) > 1e-3 * np.max(np.abs(state.theta))
+    _, state1 = law.step(law.paper_params(theorem=1), law.initial_state(p), m)
+    assert not np.any(state1.theta_delta)
+
+
 def test_weights_never_leave_the_bound_over_saturated_steps():
     p = law.paper_params(theorem=2)
     tau0 = 37.0
@@ -186,7 +209,8 @@ def test_invalid_input_gives_zero_output_and_leaves_the_weights(field, index, va
     out = controller(LosMeasurement(**{**good.__dict__, field: bad_value}))
     assert out.status == law.STATUS_INVALID_INPUT
     assert not np.any(out.force) and not np.any(out.torque) and not np.any(out.w_hat)
-    assert controller.state is before
+    assert controller.state.theta is before.theta and controller.state.theta_delta is before.theta_delta
+    assert np.any(before.command != 0) and not np.any(controller.state.command)   # the command sent was 0
 
 
 def test_wrapped_angle_differences():
