@@ -20,6 +20,8 @@ from codegen import reading, values
 from codegen.errors import CodegenError
 
 NODES_MIN, NODES_MAX = 2, 15      # 15 nodes: 90 weights per network, well inside the 64 KB CCM
+GAMMA_MAX = 1e4                  # adaptive gains gamma, gamma_delta
+THETA_MAX_MAX = 1e6              # weight bounds theta_max_orbit, theta_max_attitude
 
 
 class RbfParamsError(CodegenError):
@@ -134,6 +136,12 @@ def _validate(p: RbfParams) -> None:
     values.float32_in(p.speed_max, "'speed_max'", 0.0, 1e4, low_open=True, error=RbfParamsError)
     values.float32_in(p.rate_max, "'rate_max'", 0.0, 10.0, low_open=True, error=RbfParamsError)
     values.float32_in(p.accel_max, "'accel_max'", 0.0, 1e3, low_open=True, error=RbfParamsError)
+    # caps that keep every intermediate of a valid step finite (codegen/units/rbf/emit.py, RESULT_MAX):
+    # the adaptation's a = T gamma and the weight bounds
+    for key in ("gamma", "gamma_delta"):
+        values.float32_in(_value(p, key), f"'{key}'", 0.0, GAMMA_MAX, low_open=True, error=RbfParamsError)
+    for key in ("theta_max_orbit", "theta_max_attitude"):
+        values.float32_in(_value(p, key), f"'{key}'", 0.0, THETA_MAX_MAX, low_open=True, error=RbfParamsError)
     # the leakage factor 1 - period*gamma*lambda stays in (0, 1] for any period <= 1 s
     if p.gamma * p.lam >= 1.0 or p.gamma_delta * p.lam >= 1.0:
         raise RbfParamsError(f"'gamma'*'lambda' and 'gamma_delta'*'lambda' must be < 1 (got {p.gamma * p.lam:g}, "
