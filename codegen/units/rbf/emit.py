@@ -61,6 +61,8 @@ class Constants32:
     k2: np.ndarray          # (6,)
     inv_scale: np.ndarray   # (12,) 1 / input_scale
     centres: np.ndarray     # (nodes,)
+    basis_c2: np.ndarray    # (nodes,) 2 c_j
+    basis_c3: np.ndarray    # (nodes,) 12 c_j^2 (the squared distance expanded: (S2 - 2 c_j S1) + 12 c_j^2)
     gyro: np.ndarray        # (3,) (J1 - J2)/J0, (J2 - J0)/J1, (J0 - J1)/J2
     inertia: np.ndarray     # (3,)
     theta_max: np.ndarray   # (6,) the bound of each column
@@ -120,7 +122,8 @@ def constants32(p: RbfParams, period: float) -> Constants32:
     return Constants32(
         theorem=p.theorem, nodes=p.nodes, scalars=sc,
         k1=np.array(p.k1, dtype=np.float32), k2=np.array(p.k2, dtype=np.float32), inv_scale=inv_scale,
-        centres=p.centres().astype(np.float32), gyro=gyro.astype(np.float32),
+        centres=p.centres().astype(np.float32),
+        basis_c2=(2.0 * p.centres()).astype(np.float32), basis_c3=(12.0 * p.centres() ** 2).astype(np.float32), gyro=gyro.astype(np.float32),
         inertia=np.array(J, dtype=np.float32), theta_max=theta_max,
         theta_max_bits=theta_max.view(np.uint32).copy(), pow=pow_tables(y, np.float32(1.0)))
 
@@ -172,6 +175,7 @@ def template_context(p: RbfParams, period: float, name: str) -> dict:
         "pow": c.pow, "pow_init": pow_initializer(c.pow),
         "status": {k: getattr(records, k) for k in dir(records) if k.startswith("STATUS_")},
         "force_max_text": _text(p.force_max), "torque_max_text": _text(p.torque_max),
+        "basis": [(c_float(a), c_float(b)) for a, b in zip(c.basis_c2, c.basis_c3)],
         "bits": {k: f"0x{int(c.scalars[k].view(np.uint32)):08x}u" for k in
                  ("rho_min", "rho_max", "tilt_max", "angle_max", "speed_max", "rate_max", "accel_max")},
         "box": BOX,

@@ -147,17 +147,20 @@ def law(k: Constants32, inp):
 
 
 def basis(k: Constants32, e):
-    """phi_j = exp(-sum_i (e_i / s_i - c_j)^2 / (2 sigma^2)), j = 0 .. nodes - 1."""
-    x = [f32(e[i] * k.inv_scale[i]) for i in range(12)]
+    """phi_j = exp(max(min(-d_j / (2 sigma^2), 0), -87)), d_j = sum_i (x_i - c_j)^2 = (S2 - 2 c_j S1) + 12 c_j^2,
+    x = e / s: S1 = sum x_i, S2 = sum x_i^2 (left to right)."""
+    s1 = f32(e[0] * k.inv_scale[0])
+    s2 = s1 * s1
+    for i in range(1, 12):
+        x = f32(e[i] * k.inv_scale[i])
+        s1 = s1 + x
+        s2 = s2 + x * x
     phi = []
     for j in range(k.nodes):
-        c = k.centres[j]
-        d = x[0] - c
-        acc = d * d
-        for i in range(1, 12):
-            d = x[i] - c
-            acc = acc + d * d
-        phi.append(f32(detmath.expf(acc * k.neg_inv_2s2), "phi"))
+        t = ((s2 - k.basis_c2[j] * s1) + k.basis_c3[j]) * k.neg_inv_2s2
+        t = np.where(t >= F32(-87.0), t, F32(-87.0))
+        t = np.where(t <= F32(0.0), t, F32(0.0))
+        phi.append(f32(detmath.expf(f32(t)), "phi"))
     return phi
 
 
