@@ -41,8 +41,11 @@ def _operating(k: Constants32, rng, n: int, err_scale: float = 1.0) -> np.ndarra
     x = np.zeros((n, N_IN))
     tilt = min(float(k.tilt_max), 0.5)
 
+    row_scale = np.exp(rng.uniform(np.log(1e-3), 0.0, n)) * err_scale   # from fine tracking to the approach
+
     def err(scale, size):
-        return np.exp(rng.uniform(np.log(1e-5), np.log(1.0), size)) * scale * err_scale * rng.choice([-1.0, 1.0], size)
+        return (np.exp(rng.uniform(np.log(1e-5), np.log(1.0), size)) * scale * row_scale
+                * rng.choice([-1.0, 1.0], size))
     rho_d = rng.uniform(50.0, 300.0, n)
     x[:, _index("los_d", 0)] = rho_d
     x[:, _index("los_d", 1)] = rng.uniform(-tilt, tilt, n) * 0.8
@@ -64,9 +67,12 @@ def _operating(k: Constants32, rng, n: int, err_scale: float = 1.0) -> np.ndarra
         x[:, _index("los_rate", j)] = x[:, _index("los_d_rate", j)] + err(0.05, n)
     for j in range(3):
         x[:, _index("euler_d_rate", j)] = rng.uniform(-0.02, 0.02, n)
-        x[:, _index("omega", j)] = err(0.1, n)
         x[:, _index("euler_d_acc", j)] = rng.uniform(-1e-3, 1e-3, n)
         x[:, _index("los_d_acc", j)] = rng.uniform(-1e-2, 1e-2, n) * (10.0 if j == 0 else 0.01)
+    om = _euler_rates_to_omega(x[:, _index("euler", 0)], x[:, _index("euler", 1)],
+                               *(x[:, _index("euler_d_rate", j)] for j in range(3)))
+    for j in range(3):   # the desired body rate plus an error
+        x[:, _index("omega", j)] = om[j] + err(0.1, n)
     return x
 
 
@@ -83,7 +89,9 @@ def _theorem1_state(k: Constants32, w: np.ndarray) -> np.ndarray:
 
 
 def _class_inside(k, rng, n):
-    return _theorem1_state(k, _weights(k, rng, n, 0.5)), _operating(k, rng, n)
+    """Weights from freshly adapted (|theta| ~ 1e-5 bound) to half the bound, row by row."""
+    w = _weights(k, rng, n, 1.0) * np.exp(rng.uniform(np.log(1e-5), np.log(0.5), (n, 1))).astype(F32)
+    return _theorem1_state(k, w.astype(F32)), _operating(k, rng, n)
 
 
 def _limits(k: Constants32) -> dict[int, tuple[float, float]]:
