@@ -236,7 +236,12 @@ def gate_sequences(k: Constants32, n_seq: int, steps: int, seed: int, period: fl
             a = w * t + ph
             return amp * np.sin(a), amp * w * np.cos(a), -amp * w * w * np.sin(a)
 
+        # every third sequence: an approach with large errors and a persistent bias (weights reach their
+        # bounds); the others: fine tracking, errors of 1e-4 .. 1e-2 of the approach's
+        level = 1.0 if s % 3 == 0 else float(np.exp(rng.uniform(np.log(1e-4), np.log(1e-2))))
+
         def err(scale):
+            scale = scale * level
             tau = rng.uniform(5.0, 100.0)
             e0 = rng.uniform(-1.0, 1.0) * scale
             amp, w, ph = rng.uniform(0.01, 0.1) * scale, rng.uniform(0.01, 0.3), rng.uniform(0, 2 * np.pi)
