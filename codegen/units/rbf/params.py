@@ -122,7 +122,7 @@ def _validate(p: RbfParams) -> None:
     for key, n in _VECTOR_KEYS.items():
         v = _value(p, key)
         if not isinstance(v, (list, tuple)) or len(v) != n:
-            raise RbfParamsError(f"'{key}' must be a list of {n} numbers, got {values.show(v)}")
+            raise RbfParamsError(f"'{key}': must be a list of {n} numbers, got {values.show(v)}")
         for i, x in enumerate(v):
             values.float32_in(x, f"'{key}'[{i}]", 0.0, low_open=True, error=RbfParamsError)
     for key in _POSITIVE_KEYS + _LIMIT_KEYS:
@@ -154,7 +154,7 @@ def params_from_mapping(data: dict) -> RbfParams:
         raise RbfParamsError(f"parameters must be a table/object, got {type(data).__name__}")
     unknown = sorted(set(data) - set(_REQUIRED_KEYS) - set(_OPTIONAL_KEYS))
     if unknown:
-        raise RbfParamsError(f"unknown key '{values.show(unknown[0])}'")
+        raise RbfParamsError(f"unknown key {values.show(unknown[0])}")
     for key in _REQUIRED_KEYS:
         if key not in data:
             raise RbfParamsError(f"missing key '{key}'")
