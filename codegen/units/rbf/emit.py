@@ -175,7 +175,7 @@ def template_context(p: RbfParams, period: float, name: str) -> dict:
         "pow": c.pow, "pow_init": pow_initializer(c.pow),
         "status": {k: getattr(records, k) for k in dir(records) if k.startswith("STATUS_")},
         "force_max_text": _text(p.force_max), "torque_max_text": _text(p.torque_max),
-        "basis": [(c_float(a), c_float(b)) for a, b in zip(c.basis_c2, c.basis_c3)],
+        "basis": [(c_float(a), c_float(b), bool(b != 0)) for a, b in zip(c.basis_c2, c.basis_c3)],
         "bits": {k: f"0x{int(c.scalars[k].view(np.uint32)):08x}u" for k in
                  ("rho_min", "rho_max", "tilt_max", "angle_max", "speed_max", "rate_max", "accel_max")},
         "box": BOX,

@@ -86,8 +86,8 @@ def law(k: Constants32, inp):
     psid = (cth * w2 - sth * w0) * icphi
     thd = w1 - sphi * psid
     # step 3: errors
-    e1 = [rho - rho_r, wrap(k, qe - qe_r), wrap(k, qb - qb_r), wrap(k, phi - phi_f), wrap(k, th - th_f),
-          wrap(k, psi - psi_f)]
+    # the tilt angles (q_eps, phi) differ by at most 2 tilt_max <= 2.8 < pi: no wrap
+    e1 = [rho - rho_r, qe - qe_r, wrap(k, qb - qb_r), phi - phi_f, wrap(k, th - th_f), wrap(k, psi - psi_f)]
     sthcphi, cthcphi = sth * cphi, cth * cphi
     wd0 = cth * phid_f - sthcphi * psid_f
     wd1 = thd_f + sphi * psid_f

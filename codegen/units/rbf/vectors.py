@@ -192,7 +192,36 @@ def _class_saturated(k, rng, n):
     x[:, _index("los_rate", 0)] = rng.uniform(-20.0, 20.0, n)
     for j in range(3):
         x[:, _index("omega", j)] = rng.uniform(-1.0, 1.0, n) * float(k.rate_max)
+    # half the rows: e / s at a node's centre (phi_j ~ 1, z of the centre's sign) with that node's
+    # weights at the bound of the same sign, so the adaptation clips every node's weights
+    half = n // 2
+    node = rng.integers(0, k.nodes, half)
+    c = k.centres.astype(np.float64)[node] * (1.0 + rng.uniform(-1e-3, 1e-3, half))
+    _at_node(k, x[:half], c)
+    w = state[:half].reshape(half, 2, k.nodes, 6)
+    sign = np.where(c >= 0.0, 1.0, -1.0).astype(F32)
+    w[np.arange(half), :, node, :] = (sign[:, None, None] * k.theta_max[None, None, :]).astype(F32)
     return _theorem1_state(k, state), x
+
+
+def _at_node(k: Constants32, x: np.ndarray, c: np.ndarray) -> None:
+    """Rows whose normalised errors e_i / s_i all equal c (in place): e1 = c s[0:6], e2 = c s[6:12]."""
+    s = np.array([1.0 / float(v) for v in k.inv_scale])
+    x[:, _index("los_d", 0)] = 200.0
+    x[:, _index("los", 0)] = 200.0 + c * s[0]
+    for j, (m, d) in enumerate((("los", "los_d"), ("los", "los_d"), ("euler", "euler_d"), ("euler", "euler_d"),
+                                ("euler", "euler_d"))):
+        col = (1, 2, 0, 1, 2)[j]
+        x[:, _index(d, col)] = np.clip(x[:, _index(d, col)], -0.5 * float(k.tilt_max), 0.5 * float(k.tilt_max)) \
+            if (m, col) in (("los", 1), ("euler", 0)) else x[:, _index(d, col)]
+        x[:, _index(m, col)] = x[:, _index(d, col)] + c * s[1 + j]
+    for j in range(3):
+        x[:, _index("los_rate", j)] = x[:, _index("los_d_rate", j)] + c * s[6 + j]
+    om = _euler_rates_to_omega(x[:, _index("euler", 0)], x[:, _index("euler", 1)],
+                               *(x[:, _index("euler_d_rate", j)] for j in range(3)))
+    # omega - R Theta_f' = c s: the attitude part of e2 (R at the measured angles, as the law's omega_d)
+    for j in range(3):
+        x[:, _index("omega", j)] = om[j] + c * s[9 + j]
 
 
 _MAKERS = {"inside": _class_inside, "edges": _class_edges, "outside": _class_outside, "special": _class_special,

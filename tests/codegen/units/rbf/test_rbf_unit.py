@@ -181,6 +181,20 @@ def test_repair_resets_non_finite_and_clips_beyond_the_bound():
     assert np.all(c_out["status"] & rec.STATUS_STATE_REPAIRED)
 
 
+def test_a_result_beyond_the_guard_is_invalid_and_leaves_the_weights():
+    """k2 = 3e38 (a valid float32): K2 sig(z)^alpha overflows for most rows; the guard (sum |v'| + sum |z|
+    <= 1e30) makes them INVALID_INPUT with zero output and the weights unchanged, in golden and C."""
+    unit = RbfUnit(params_from_mapping({**PAPER.to_mapping(), "k2": [3e38] * 6}))
+    b = unit.gate_classes(6 * 200, seed=29)["inside"]
+    out, after = unit.golden(b.state, b.input)
+    c_out, c_after = runner(unit, "x86").records(b)
+    assert compare_fields(out, c_out) == [] and compare_fields(after, c_after) == []
+    invalid = out["status"] == rec.STATUS_INVALID_INPUT
+    assert invalid.sum() > 100
+    assert compare_fields(b.state[invalid], after[invalid]) == []
+    assert unit.check_outputs(out) == [] and unit.check_state(after) == []
+
+
 def test_theorem_1_leaves_theta_delta_zero_and_adapts_theta():
     unit = RbfUnit(THEOREM1)
     seqs = unit.gate_sequences(3, 300, seed=26)
