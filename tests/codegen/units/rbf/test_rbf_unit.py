@@ -271,3 +271,36 @@ def test_parameter_errors_are_one_line_through_the_cli(tmp_path, capsys, edit, m
 def test_the_unit_needs_its_parameters(capsys):
     assert cli.main(["verify", "--unit", "rbf", "--vectors", "10"]) == 2
     assert "unit rbf needs --params FILE" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------- the generated C
+
+
+def test_the_package_self_test_passes_and_clang_compiles_it(tmp_path):
+    """The flight package's self-test (codegen.package.selftest) with the gate classes' vectors returns 0
+    on x86; gcc and clang compile the unit with the flight flags (-Werror)."""
+    import shutil
+    import subprocess
+
+    from codegen.package.selftest import make_vectors, selftest_sources
+    from firmware.flags import COMMON
+
+    unit = RbfUnit(PAPER, name="stare_rbf")
+    files = {**unit.sources(), **selftest_sources("stare", [make_vectors(unit, 128, 0)])}
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    (tmp_path / "main.c").write_text('#include <stdio.h>\nint stare_selftest(void);\n'
+                                     'int main(void) { printf("%d\\n", stare_selftest()); return 0; }\n')
+    objs = []
+    for name in sorted(n for n in files if n.endswith(".c")):
+        obj = tmp_path / (name[:-2] + ".o")
+        subprocess.run(["gcc", *COMMON, "-c", str(tmp_path / name), "-o", str(obj)], check=True, capture_output=True)
+        objs.append(str(obj))
+    subprocess.run(["gcc", "-O1", str(tmp_path / "main.c"), *objs, "-o", str(tmp_path / "st")], check=True,
+                   capture_output=True)
+    assert subprocess.run([str(tmp_path / "st")], capture_output=True, text=True, check=True).stdout == "0\n"
+    if shutil.which("clang"):
+        flags = [f for f in COMMON if f != "-fexcess-precision=standard"]
+        res = subprocess.run(["clang", *flags, "-c", str(tmp_path / "stare_rbf.c"), "-o", str(tmp_path / "c.o")],
+                             capture_output=True, text=True)
+        assert res.returncode == 0, res.stderr
