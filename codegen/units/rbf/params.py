@@ -59,6 +59,8 @@ class RbfParams:
     force_max          thrust limit per body axis (N); torque_max torque limit per body axis (N*m).
     theta_max_orbit    weight bound of the three orbit columns (m/s^2, rad/s^2 per unit basis value);
     theta_max_attitude weight bound of the three attitude columns (rad/s^2).
+                       gamma, gamma_delta <= GAMMA_MAX and the bounds <= THETA_MAX_MAX: with the generated
+                       step's result guard nothing in a valid step can overflow (codegen/units/rbf/emit.py).
     rho_min..accel_max the box of valid inputs: rho and rho_d in [rho_min, rho_max] m; |q_eps|, |q_eps_d|,
                        |phi|, |phi_f| <= tilt_max rad; |range rates| <= speed_max m/s; |angular rates|
                        <= rate_max rad/s; |desired accelerations| <= accel_max (m/s^2, rad/s^2).
