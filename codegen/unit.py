@@ -214,6 +214,11 @@ class Unit(ABC):
         """Invariants of the golden outputs beyond bit-exactness (e.g. a torque bound); [] if held."""
         return []
 
+    def check_state(self, state: np.ndarray) -> list[str]:
+        """Invariants of the golden states after a step (stateful units, e.g. weights within their
+        bounds); [] if held. The gate and the fuzzer apply it to every state they compute."""
+        return []
+
     def describe_outputs(self, out: np.ndarray) -> str | None:
         """One line summarising golden outputs (e.g. status counts), or None."""
         return None

@@ -1,7 +1,8 @@
 """Random-bit fuzzing of any unit: records of uniformly random 32-bit words (every NaN payload,
 subnormal, infinity and integer) through the unit's C built for x86-64 with AddressSanitizer and
 UndefinedBehaviorSanitizer (first report aborts), compared word for word with the golden model,
-and the golden outputs held to the unit's invariants (e.g. a finite torque within the limit).
+and the golden outputs and states held to the unit's invariants (e.g. a finite torque within the limit,
+weights within their bounds: Unit.check_outputs, Unit.check_state).
 
 The sanitizer build is a small executable (records in on stdin, records out on stdout), not the
 cffi module: ASan must own the process from its start.
@@ -123,6 +124,8 @@ def fuzz(unit: Unit, n: int, seed: int = 0, log=print, progress=None) -> FuzzRes
             if unit.stateful:
                 result.mismatches += count_mismatches(g_state, c_state)
             result.invariant_problems += unit.check_outputs(g_out)
+            if unit.stateful:
+                result.invariant_problems += unit.check_state(g_state)
             done += m
             result.records = done
             if progress is not None:

@@ -98,6 +98,8 @@ def run_gate(unit: Unit, n: int, n_seq: int = 0, steps: int = 1000, seed: int = 
     invariants = unit.check_outputs(np.concatenate(list(outs.values())))
     if g_seq is not None:
         invariants += unit.check_outputs(g_seq.reshape(-1))
+    if unit.stateful:
+        invariants += unit.check_state(np.concatenate([s for _, s in golden.values()]))
     _log_problems(result, "golden", invariants, log, "invariants hold")
     for target in targets:
         t0 = time.perf_counter()

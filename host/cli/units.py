@@ -32,7 +32,7 @@ def add_unit_arguments(parser: argparse.ArgumentParser, default: str = "network"
     parser.add_argument("--params", metavar="FILE", help="the unit's parameter file, .toml/.json (units tanh, rbf)")
     parser.add_argument("--tables", metavar="FILE", help="discrete-point tables (unit dp; `staregen dp build`)")
     parser.add_argument("--period", default=None, metavar="S", help="control period baked into the unit, s "
-                        "(unit tanh; default 0.1)")
+                        "(units tanh, rbf; default 0.1)")
     parser.add_argument("--name", default=None, help="entry name: files <name>.h/.c, functions <name>_* "
                         "(default: the unit's name)")
 

@@ -9,7 +9,7 @@ import pytest
 from codegen.artifact import random_artifact
 from codegen.units.network.unit import NetworkUnit
 from host.cli import main
-from host.cli.units import PAPER000_PARAMS, report_units
+from host.cli.units import PAPER000_PARAMS, PAPER002_PARAMS, report_units
 from tools.coverage import LIBRARY, measure, report_lines
 
 ARTIFACT = random_artifact((6, 8, 2), seed=5)
@@ -78,6 +78,7 @@ UNREACHABLE = {
                    "} else if ib < CONTROLLER_NN_TANH_HALF {", "y[0] = s0 != s0 ? nan.f : s0;",
                    "y[1] = s1 != s1 ? nan.f : s1;", "y[2] = s2 != s2 ? nan.f : s2;"),
     "network": (),
+    "rbf": ("return acc <= RBF_RESULT_MAX ? 1u : 0u;",),
     "tanh": (),
 }
 NETWORK_FILE = {"controller": ("controller_nn.c", "controller_nn"), "network": ("network.c", "network")}
@@ -89,8 +90,8 @@ def _bare(code: str) -> str:
 
 @pytest.mark.parametrize("kind", sorted(UNREACHABLE))
 def test_untaken_unit_branches_are_the_documented_ones(kind):
-    unit = next(u for u in report_units(argparse.Namespace(unit=kind, artifact=None,
-                                                           params=str(PAPER000_PARAMS))))
+    unit = next(u for u in report_units(argparse.Namespace(unit=kind, artifact=None, params=str(PAPER000_PARAMS),
+                                                           rbf_params=str(PAPER002_PARAMS))))
     rep = measure(unit, n=10_000, n_seq=2, steps=200)
     allowed = [_bare(a) for a in UNREACHABLE[kind]]
     stray = []

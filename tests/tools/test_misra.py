@@ -13,7 +13,7 @@ from codegen import units
 from codegen.artifact import random_artifact
 from codegen.units.network.unit import NetworkUnit
 from host.cli.misra import DEVIATIONS
-from host.cli.units import report_units
+from host.cli.units import PAPER002_PARAMS, report_units
 from tools.errors import ToolError
 from tools.misra import Deviation, Finding, check, load_deviations, undocumented
 
@@ -56,7 +56,7 @@ def test_the_shipped_deviations_parse():
 
 def _report_findings(kind: str) -> list[Finding]:
     """cppcheck's findings for a unit bound to the inputs of `staregen misra` (report_units)."""
-    args = argparse.Namespace(unit=kind, artifact=None, params=str(TANH_PARAMS))
+    args = argparse.Namespace(unit=kind, artifact=None, params=str(TANH_PARAMS), rbf_params=str(PAPER002_PARAMS))
     (unit,) = report_units(args)
     return check(unit)
 

@@ -20,6 +20,8 @@ from codegen import reading, values
 from codegen.errors import CodegenError
 
 NODES_MIN, NODES_MAX = 2, 15      # 15 nodes: 90 weights per network, well inside the 64 KB CCM
+GAMMA_MAX = 1e4                  # adaptive gains gamma, gamma_delta
+THETA_MAX_MAX = 1e6              # weight bounds theta_max_orbit, theta_max_attitude
 
 
 class RbfParamsError(CodegenError):
@@ -57,6 +59,8 @@ class RbfParams:
     force_max          thrust limit per body axis (N); torque_max torque limit per body axis (N*m).
     theta_max_orbit    weight bound of the three orbit columns (m/s^2, rad/s^2 per unit basis value);
     theta_max_attitude weight bound of the three attitude columns (rad/s^2).
+                       gamma, gamma_delta <= GAMMA_MAX and the bounds <= THETA_MAX_MAX: with the generated
+                       step's result guard nothing in a valid step can overflow (codegen/units/rbf/emit.py).
     rho_min..accel_max the box of valid inputs: rho and rho_d in [rho_min, rho_max] m; |q_eps|, |q_eps_d|,
                        |phi|, |phi_f| <= tilt_max rad; |range rates| <= speed_max m/s; |angular rates|
                        <= rate_max rad/s; |desired accelerations| <= accel_max (m/s^2, rad/s^2).
@@ -120,7 +124,7 @@ def _validate(p: RbfParams) -> None:
     for key, n in _VECTOR_KEYS.items():
         v = _value(p, key)
         if not isinstance(v, (list, tuple)) or len(v) != n:
-            raise RbfParamsError(f"'{key}' must be a list of {n} numbers, got {values.show(v)}")
+            raise RbfParamsError(f"'{key}': must be a list of {n} numbers, got {values.show(v)}")
         for i, x in enumerate(v):
             values.float32_in(x, f"'{key}'[{i}]", 0.0, low_open=True, error=RbfParamsError)
     for key in _POSITIVE_KEYS + _LIMIT_KEYS:
@@ -134,6 +138,12 @@ def _validate(p: RbfParams) -> None:
     values.float32_in(p.speed_max, "'speed_max'", 0.0, 1e4, low_open=True, error=RbfParamsError)
     values.float32_in(p.rate_max, "'rate_max'", 0.0, 10.0, low_open=True, error=RbfParamsError)
     values.float32_in(p.accel_max, "'accel_max'", 0.0, 1e3, low_open=True, error=RbfParamsError)
+    # caps that keep every intermediate of a valid step finite (codegen/units/rbf/emit.py, RESULT_MAX):
+    # the adaptation's a = T gamma and the weight bounds
+    for key in ("gamma", "gamma_delta"):
+        values.float32_in(_value(p, key), f"'{key}'", 0.0, GAMMA_MAX, low_open=True, error=RbfParamsError)
+    for key in ("theta_max_orbit", "theta_max_attitude"):
+        values.float32_in(_value(p, key), f"'{key}'", 0.0, THETA_MAX_MAX, low_open=True, error=RbfParamsError)
     # the leakage factor 1 - period*gamma*lambda stays in (0, 1] for any period <= 1 s
     if p.gamma * p.lam >= 1.0 or p.gamma_delta * p.lam >= 1.0:
         raise RbfParamsError(f"'gamma'*'lambda' and 'gamma_delta'*'lambda' must be < 1 (got {p.gamma * p.lam:g}, "
@@ -146,7 +156,7 @@ def params_from_mapping(data: dict) -> RbfParams:
         raise RbfParamsError(f"parameters must be a table/object, got {type(data).__name__}")
     unknown = sorted(set(data) - set(_REQUIRED_KEYS) - set(_OPTIONAL_KEYS))
     if unknown:
-        raise RbfParamsError(f"unknown key '{values.show(unknown[0])}'")
+        raise RbfParamsError(f"unknown key {values.show(unknown[0])}")
     for key in _REQUIRED_KEYS:
         if key not in data:
             raise RbfParamsError(f"missing key '{key}'")

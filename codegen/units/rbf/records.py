@@ -18,6 +18,7 @@ STATUS_INVALID_INPUT = 1      # outside the valid box: zero output, weights unch
 STATUS_FORCE_LIMITED = 2      # a force component was clipped to +-force_max
 STATUS_TORQUE_LIMITED = 4     # a torque component was clipped to +-torque_max
 STATUS_WEIGHT_BOUND = 8       # the adaptation clipped a weight to its bound
+STATUS_STATE_REPAIRED = 16    # on entry a weight was non-finite (reset to 0) or beyond its bound (clipped)
 
 
 def state_dtype(nodes: int) -> np.dtype:
