@@ -10,7 +10,8 @@ import argparse
 from pathlib import Path
 
 from codegen import artifact as art
-from host.sim import tanh_example, tanh_in_loop
+from codegen.units.rbf.params import load_params as load_rbf_params
+from host.sim import rbf_example, tanh_example, tanh_in_loop
 from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
 from host.control.baselines import load_baselines
@@ -27,6 +28,9 @@ DEFAULT_DURATION_S = 100.0
 MAX_DURATION_S = 100_000.0    # a staring pass lasts minutes; this bounds memory (histories) too
 MIN_PERIOD_S, MAX_PERIOD_S = 1e-4, 10.0
 MIN_DT_S = 1e-6
+RBF_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "rbf_paper002.toml"
+RBF_DEFAULT_DURATION_S = 1000.0      # paper 002, section 3.1
+RBF_MAX_DURATION_S = 20_000.0        # ten hours of a 10 Hz loop in Python: a bound on time and memory
 OWNED = json_marker_owner("metrics.json")   # an earlier simulation's folder: replaced as a whole
 
 
@@ -36,10 +40,15 @@ def register(subparsers) -> None:
     p.add_argument("--controller", default="pid",
                    help=f"controller ({', '.join(sorted(CONTROLLERS))}, or 'tanh' for the paper-000 "
                         "finite-time example, 'tanh-c' / 'tanh-arm' for it with the generated C in the loop: "
-                        "SIL x86 / PIL ARM emulator; default pid)")
+                        "SIL x86 / PIL ARM emulator; 'rbf' for paper 002's RBF adaptive law on its tracking "
+                        "scenario, 'rbf-c' / 'rbf-arm' for its generated C in the loop; default pid)")
     p.add_argument("--period", default=None,
-                   help="tanh only: control period in s (zero-order hold); omitted = continuous reference")
-    p.add_argument("--dt", default=None, help="tanh only: plant RK4 step in s (default 5e-4)")
+                   help="tanh and rbf only: control period in s (zero-order hold); tanh: omitted = continuous "
+                        "reference; rbf: default 0.1")
+    p.add_argument("--dt", default=None, help="tanh and rbf only: plant RK4 step in s (default 5e-4; rbf 0.01)")
+    p.add_argument("--params", default=None, metavar="FILE",
+                   help="rbf only: the law's parameter file (default docs/rbf_paper002.toml, theorem 2; "
+                        "docs/rbf_paper002_theorem1.toml for theorem 1)")
     p.add_argument("--artifact", default=None, metavar="FILE",
                    help="model artifact for the network controllers (nn, nn-c, pid-c, nn-arm); "
                         "default: a stand-in network fitted to the PID law")
@@ -106,6 +115,53 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     return 0
 
 
+def run_rbf_example(args: argparse.Namespace) -> int:
+    """Paper 002's tracking scenario (260 m -> 100 m, line-of-sight tracking of a tumbling, manoeuvring
+    target) flown by the RBF law: float64 (rbf) or the generated C in the loop (rbf-c, rbf-arm)."""
+    if args.target != "central" or args.scenario is not None:
+        raise HostError("--target and --scenario do not apply to the rbf controllers (paper 002's own scenario)")
+    params = load_rbf_params(args.params if args.params is not None else RBF_PARAMS)
+    duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else str(RBF_DEFAULT_DURATION_S),
+                            "--duration", positive=True, maximum=RBF_MAX_DURATION_S)
+    period = parse_number(args.period or "0.1", "--period", minimum=0.01, maximum=1.0)
+    dt = parse_number(args.dt or "0.01", "--dt", minimum=MIN_DT_S, maximum=period)
+    out = Path(args.out)
+    check_output_folder(out, OWNED, [args.params])
+    try:
+        with atomic.directory(out) as tmp:
+            m = rbf_example.run(args.controller, params, duration, period, dt, out_dir=tmp)["metrics"]
+    except OSError as exc:
+        raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
+    print("\n".join(rbf_summary(m)))
+    print(f"wrote {out}/metrics.json")
+    return 0
+
+
+def _seconds(x) -> str:
+    return "never" if x is None else f"{x:.1f} s"
+
+
+def rbf_summary(m: dict) -> list[str]:
+    att = m["t_attitude_1deg"]
+    lines = [f"{m['controller']}: paper 002 tracking scenario, theorem {m['theorem']}, T = {m['period']:g} s, "
+             f"{m['duration']:g} s" + (f", {m['mode']}" if "mode" in m else ""),
+             f"  range within 5 m / 1 m of 100 m (to stay) {_seconds(m['t_rho_5m'])} / {_seconds(m['t_rho_1m'])}"
+             f"   (paper: 22.9 s); closest approach {m['min_rho']:.1f} m at {m['t_min_rho']:.1f} s",
+             "  attitude within 1 deg (phi, theta, psi)   " + ", ".join(_seconds(x) for x in att)
+             + "   (paper: 5.7 s)",
+             f"  delta-v {m['delta_v']:.1f} m/s, torque impulse {m['torque_impulse']:.2f} N*m*s, "
+             f"weight bound active {m['weight_bound_active_steps']} steps"]
+    if "rms_e1" in m:
+        lines.append("  RMS error over [%g, %g] s: rho %.2e m, LOS %.2e %.2e rad, attitude %.2e %.2e %.2e rad"
+                     % (*m["accuracy_window"], *m["rms_e1"]))
+    if "golden_mismatch_steps" in m:
+        lines.append(f"  golden mismatches {m['golden_mismatch_steps']} steps; against float64: max |d rho| "
+                     f"{m['max_rho_diff_m']:.2e} m, max |d attitude| {m['max_attitude_diff_deg']:.2e} deg")
+    if "cycles_max" in m:
+        lines.append(f"  cycles per step (ideal memory): median {m['cycles_median']}, max {m['cycles_max']}")
+    return lines
+
+
 def controller_options(args) -> dict:
     """Factory options: the artifact of a network controller, the baselines file of a fitted
     baseline (each checked here: a clear user error)."""
@@ -138,10 +194,14 @@ def controller_options(args) -> dict:
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.controller in rbf_example.CONTROLLERS:
+        return run_rbf_example(args)
+    if args.params is not None:
+        raise HostError("--params applies to --controller rbf, rbf-c, rbf-arm only")
     if args.controller in ("tanh", "tanh-c", "tanh-arm"):
         return run_tanh_example(args)
     if args.period is not None or args.dt is not None:
-        raise HostError("--period and --dt apply to --controller tanh only")
+        raise HostError("--period and --dt apply to --controller tanh and rbf only")
     targets = parse_target(args.target)
     scenario = load_scenario(args.scenario)
     config, plan = build_config(args, scenario.errors), build_plan(args)
