@@ -11,6 +11,7 @@ import pytest
 
 from codegen.artifact import random_artifact
 from codegen.package import manifest
+from codegen.units.rbf.params import example_params as rbf_example_params
 from codegen.units.tanh.params import example_params
 from firmware.errors import FirmwareError
 from firmware.package_build import build_image
@@ -24,9 +25,9 @@ PLAN = EvidencePlan(gate_vectors=2_000, gate_sequences=2, sequence_steps=100, se
 ARTIFACT = random_artifact((12, 40, 3), seed=1)
 
 
-def generate(out: Path, cfg=None, tanh=None):
+def generate(out: Path, cfg=None, params: dict | None = None):
     cfg = cfg or default_package_config()
-    units = package_units(cfg, ARTIFACT, {"tanh": tanh} if tanh is not None else None)
+    units = package_units(cfg, ARTIFACT, params)
     return build_package(out, cfg.name, units, cfg.to_mapping(), {"network": {"sha256": ARTIFACT.sha256}},
                          PLAN, log=lambda _line: None)
 
@@ -140,10 +141,15 @@ def test_check_package_reruns_the_selftest(package):
     assert runs["arm"]["reference_cycles"] == doc["evidence"]["package_build"]["arm"]["reference_cycles"]
 
 
-def test_package_with_the_tanh_law(tmp_path):
+def test_package_with_the_tanh_and_rbf_laws(tmp_path):
+    """Every registered unit with a parameter file joins a package by configuration alone."""
     cfg = default_package_config()
-    cfg = type(cfg)(cfg.name, ("controller", "tanh"), cfg.controller)
-    result = generate(tmp_path / "both", cfg, example_params())
-    assert "src/stare_tanh.c" in result.manifest["files"]
-    assert set(result.manifest["evidence"]["units"]) == {"controller", "tanh"}
+    cfg = type(cfg)(cfg.name, ("controller", "rbf", "tanh"), cfg.controller)
+    result = generate(tmp_path / "all", cfg, {"tanh": example_params(), "rbf": rbf_example_params()})
+    for name in ("src/stare_tanh.c", "src/stare_rbf.c", "include/stare_rbf.h"):
+        assert name in result.manifest["files"]
+    assert set(result.manifest["evidence"]["units"]) == {"controller", "rbf", "tanh"}
     assert result.manifest["evidence"]["package_build"]["arm"]["selftest_mismatches"] == 0
+    assert result.manifest["evidence"]["package_build"]["x86"]["selftest_mismatches"] == 0
+    icd = (result.folder / "ICD.md").read_text()
+    assert "## Unit `rbf`: `stare_rbf`" in icd and "`stare_rbf_state_t`" in icd
