@@ -80,12 +80,11 @@ def add_report_unit_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def report_units(args: argparse.Namespace) -> list[Unit]:
-    """The units of --unit (all registered ones for `all`) bound to --artifact / --params, the
-    others to their examples."""
+    """The units of --unit (all registered ones for `all`) bound to --artifact / --params /
+    --rbf-params, the others to their examples."""
     network = art.load(args.artifact) if args.artifact else load_artifact(None)
     inputs = {"network": {"artifact": network}, "controller": {"artifact": network},
-              "tanh": {"params": units.get("tanh").load_params(args.params)}}
-    if "rbf" in units.kinds():
-        inputs["rbf"] = {"params": units.get("rbf").load_params(args.rbf_params)}
+              "tanh": {"params": units.get("tanh").load_params(args.params)},
+              "rbf": {"params": units.get("rbf").load_params(args.rbf_params)}}
     kinds = sorted(units.kinds()) if args.unit == "all" else [args.unit]
     return [configure_unit(kind, **inputs.get(kind, units.get(kind).example())) for kind in kinds]
