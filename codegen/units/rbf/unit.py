@@ -1,5 +1,6 @@
 """Paper 002's RBF adaptive finite-time backstepping law (docs/rbf-backstepping.md section 11) as a
-generated unit: state {theta, theta_delta} (the weights, adapted on board), input {the measured and
+generated unit: state {theta, theta_delta, command} (the weights, adapted on board, and the last output
+normalised, the second network's input), input {the measured and
 desired line of sight and attitude with their derivatives}, output {force, torque, w_hat, status};
 parameters and control period baked in as float32 constants.
 """
@@ -70,7 +71,7 @@ class RbfUnit(Unit):
         return problems
 
     def check_state(self, state: np.ndarray) -> list[str]:
-        """Every weight finite and within its column's bound."""
+        """Every weight finite and within its column's bound; every command entry finite and in [-1, 1]."""
         bound = self.constants.theta_max
         problems = []
         for name in ("theta", "theta_delta"):
@@ -79,6 +80,11 @@ class RbfUnit(Unit):
                 problems.append(f"non-finite {name}")
             elif np.any(np.abs(w) > bound):
                 problems.append(f"{name} beyond its bound")
+        u = np.asarray(state["command"])
+        if not np.all(np.isfinite(u)):
+            problems.append("non-finite command")
+        elif np.any(np.abs(u) > np.float32(1.0)):
+            problems.append("command beyond [-1, 1]")
         return problems
 
     def describe_outputs(self, out: np.ndarray) -> str:
