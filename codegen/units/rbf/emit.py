@@ -183,9 +183,8 @@ def template_context(p: RbfParams, period: float, name: str) -> dict:
         "pow": c.pow, "pow_init": pow_initializer(c.pow),
         "status": {k: getattr(records, k) for k in dir(records) if k.startswith("STATUS_")},
         "force_max_text": _text(p.force_max), "torque_max_text": _text(p.torque_max),
-        # (2 c_j, 12 c_j^2, whether t <= 0 needs the clamp (c_j != 0), 18 c_j^2)
-        "basis": [(c_float(a), c_float(b), bool(a != 0), c_float(d)) for a, b, d in
-                  zip(c.basis_c2, c.basis_c3, c.basis_c3d)],
+        # (2 c_j, 12 c_j^2, 18 c_j^2)
+        "basis": [(c_float(a), c_float(b), c_float(d)) for a, b, d in zip(c.basis_c2, c.basis_c3, c.basis_c3d)],
         "bits": {k: f"0x{int(c.scalars[k].view(np.uint32)):08x}u" for k in
                  ("rho_min", "rho_max", "tilt_max", "angle_max", "speed_max", "rate_max", "accel_max")},
         "box": BOX,

@@ -148,7 +148,8 @@ def law(k: Constants32, inp):
 
 
 def _gaussians(k: Constants32, s1, s2, c3):
-    """exp(max(min(-d_j / (2 sigma^2), 0), -87)), d_j = (S2 - 2 c_j S1) + c3_j for every node j."""
+    """exp(max(min(-d_j / (2 sigma^2), 0), -87)), d_j = (S2 - 2 c_j S1) + c3_j for every node j (the C clamps
+    on the bits, <name>_exponent: the same values for every t that is not NaN, -0 included)."""
     phi = []
     for j in range(k.nodes):
         t = ((s2 - k.basis_c2[j] * s1) + c3[j]) * k.neg_inv_2s2
