@@ -8,7 +8,7 @@ from codegen.unit import FieldDoc, StatusBit
 from codegen.units.rbf import records
 from codegen.units.rbf.params import ANGLE_MAX, RbfParams
 
-INVALID = "outside it or non-finite: zero force, torque and w_hat, weights unchanged, STATUS_INVALID_INPUT"
+INVALID = "outside it or non-finite: zero force, torque and w_hat, weights unchanged, command 0, STATUS_INVALID_INPUT"
 LOS = "LOS frame (x_l along the line of sight, C_li = Rz(q_eps) Ry(q_beta))"
 
 
@@ -79,8 +79,8 @@ def status_bits() -> list[StatusBit]:
     return [
         StatusBit("STATUS_INVALID_INPUT", records.STATUS_INVALID_INPUT,
                   "an input outside the valid box or non-finite (or the law's intermediate result beyond 1e30): "
-                  "zero force, torque and w_hat, weights unchanged; caller: FDIR on the navigation source if it "
-                  "persists"),
+                  "zero force, torque and w_hat, weights unchanged, command 0; caller: FDIR on the navigation source "
+                  "if it persists"),
         StatusBit("STATUS_FORCE_LIMITED", records.STATUS_FORCE_LIMITED, "a force component was clipped to force_max"),
         StatusBit("STATUS_TORQUE_LIMITED", records.STATUS_TORQUE_LIMITED,
                   "a torque component was clipped to torque_max"),

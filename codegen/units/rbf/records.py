@@ -14,7 +14,7 @@ OUTPUT_DTYPE = np.dtype([("force", *V3), ("torque", *V3), ("w_hat", "<f4", (6,))
 
 # status bits (several may be set; 0 = nominal, nothing limited)
 STATUS_OK = 0
-STATUS_INVALID_INPUT = 1      # outside the valid box: zero output, weights unchanged
+STATUS_INVALID_INPUT = 1      # outside the valid box: zero output, weights unchanged, command 0
 STATUS_FORCE_LIMITED = 2      # a force component was clipped to +-force_max
 STATUS_TORQUE_LIMITED = 4     # a torque component was clipped to +-torque_max
 STATUS_WEIGHT_BOUND = 8       # the adaptation clipped a weight to its bound
