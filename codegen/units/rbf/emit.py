@@ -63,6 +63,7 @@ class Constants32:
     centres: np.ndarray     # (nodes,)
     basis_c2: np.ndarray    # (nodes,) 2 c_j
     basis_c3: np.ndarray    # (nodes,) 12 c_j^2 (the squared distance expanded: (S2 - 2 c_j S1) + 12 c_j^2)
+    basis_c3d: np.ndarray   # (nodes,) 18 c_j^2: the second network's basis on the 18 inputs [e / s; u_prev]
     gyro: np.ndarray        # (3,) (J1 - J2)/J0, (J2 - J0)/J1, (J0 - J1)/J2
     inertia: np.ndarray     # (3,)
     theta_max: np.ndarray   # (6,) the bound of each column
@@ -107,6 +108,8 @@ def constants32(p: RbfParams, period: float) -> Constants32:
         "a": period * p.gamma, "b": 1.0 - period * p.gamma * p.lam,
         "a_d": period * p.gamma_delta, "b_d": 1.0 - period * p.gamma_delta * p.lam,
         "mass": p.mass, "force_max": p.force_max, "torque_max": p.torque_max,
+        # the command's normalisation: the reciprocal of the float32 limit, so |limited output| * it <= 1
+        "inv_force_max": 1.0 / float(np.float32(p.force_max)), "inv_torque_max": 1.0 / float(np.float32(p.torque_max)),
         "rho_min": p.rho_min, "rho_max": p.rho_max, "tilt_max": p.tilt_max, "angle_max": ANGLE_MAX,
         "speed_max": p.speed_max, "rate_max": p.rate_max, "accel_max": p.accel_max,
         "pi": float(detmath.PI_HI), "two_pi": 2.0 * float(detmath.PI_HI), "result_max": RESULT_MAX,
@@ -117,13 +120,18 @@ def constants32(p: RbfParams, period: float) -> Constants32:
     for i, g in enumerate(gyro):       # 0 allowed (equal inertias); nonzero must be a normal float32
         if g != 0.0:
             _c32(g, f"gyro[{i}]")
-    theta_max = np.array([p.theta_max_orbit] * 3 + [p.theta_max_attitude] * 3, dtype=np.float32)
+    for lim, inv in (("force_max", "inv_force_max"), ("torque_max", "inv_torque_max")):
+        # rounding is monotonic: |x| <= limit gives |x * inv| <= fl(limit * inv), which must not exceed 1
+        if not np.float32(sc[lim] * sc[inv]) <= np.float32(1.0):
+            raise CodegenError(f"'{lim}' * (1 / '{lim}') rounds above 1 in float32")
+    theta_max = np.array(p.theta_max, dtype=np.float32)
     inv_scale = np.array([_c32(1.0 / s, f"inv_scale[{i}]") for i, s in enumerate(p.input_scale)], dtype=np.float32)
     return Constants32(
         theorem=p.theorem, nodes=p.nodes, scalars=sc,
         k1=np.array(p.k1, dtype=np.float32), k2=np.array(p.k2, dtype=np.float32), inv_scale=inv_scale,
         centres=p.centres().astype(np.float32),
-        basis_c2=(2.0 * p.centres()).astype(np.float32), basis_c3=(12.0 * p.centres() ** 2).astype(np.float32), gyro=gyro.astype(np.float32),
+        basis_c2=(2.0 * p.centres()).astype(np.float32), basis_c3=(12.0 * p.centres() ** 2).astype(np.float32),
+        basis_c3d=(18.0 * p.centres() ** 2).astype(np.float32), gyro=gyro.astype(np.float32),
         inertia=np.array(J, dtype=np.float32), theta_max=theta_max,
         theta_max_bits=theta_max.view(np.uint32).copy(), pow=pow_tables(y, np.float32(1.0)))
 
@@ -153,7 +161,6 @@ def pow_initializer(t: PowTab, indent: str = "    ") -> str:
 def template_context(p: RbfParams, period: float, name: str) -> dict:
     c = constants32(p, period)
     literal = {k: c_float(v) for k, v in c.scalars.items()}
-    literal["wmax_o"], literal["wmax_a"] = c_float(c.theta_max[0]), c_float(c.theta_max[3])
     vec = {"k1": c.k1, "k2": c.k2, "inv_scale": c.inv_scale, "centres": c.centres, "gyro": c.gyro,
            "inertia": c.inertia}
     items = []
@@ -169,13 +176,15 @@ def template_context(p: RbfParams, period: float, name: str) -> dict:
         "v": {k: [c_float(x) for x in a] for k, a in vec.items()},
         "theorem": c.theorem, "nodes": c.nodes, "weights": 6 * c.nodes,
         "theta_max_bits": [f"0x{int(b):08x}u" for b in c.theta_max_bits],
-        "theta_max_text": (_text(p.theta_max_orbit), _text(p.theta_max_attitude)),
+        "theta_max_text": [_text(x) for x in p.theta_max],
+        "theta_max_lit": [c_float(x) for x in c.theta_max],
         "generator_version": GENERATOR_VERSION, "params_sha256": params_sha256(p, period),
         "period_text": _text(period), "params_lines": params_lines,
         "pow": c.pow, "pow_init": pow_initializer(c.pow),
         "status": {k: getattr(records, k) for k in dir(records) if k.startswith("STATUS_")},
         "force_max_text": _text(p.force_max), "torque_max_text": _text(p.torque_max),
-        "basis": [(c_float(a), c_float(b), bool(b != 0)) for a, b in zip(c.basis_c2, c.basis_c3)],
+        # (2 c_j, 12 c_j^2, 18 c_j^2)
+        "basis": [(c_float(a), c_float(b), c_float(d)) for a, b, d in zip(c.basis_c2, c.basis_c3, c.basis_c3d)],
         "bits": {k: f"0x{int(c.scalars[k].view(np.uint32)):08x}u" for k in
                  ("rho_min", "rho_max", "tilt_max", "angle_max", "speed_max", "rate_max", "accel_max")},
         "box": BOX,

@@ -29,6 +29,7 @@ STATUS_TORQUE_LIMITED = rec.STATUS_TORQUE_LIMITED
 STATUS_WEIGHT_BOUND = rec.STATUS_WEIGHT_BOUND
 STATUS_STATE_REPAIRED = rec.STATUS_STATE_REPAIRED
 ABS_MASK, EXP_MASK, SIGN_MASK = U32(0x7FFFFFFF), U32(0x7F800000), U32(0x80000000)
+ONE_BITS = U32(0x3F800000)     # the command's bound, 1.0
 
 
 def pow_abs(k: Constants32, ax):
@@ -53,9 +54,9 @@ def in_box(k: Constants32, inp) -> np.ndarray:
     return ok
 
 
-def repair(bits: np.ndarray, bound_bits: np.ndarray):
-    """Entry repair of weights given as uint32 bits (..., 6): NaN/Inf -> +0, beyond the column's bound ->
-    +-bound. Returns (repaired bits, any repair per row)."""
+def repair(bits: np.ndarray, bound_bits):
+    """Entry repair of state words given as uint32 bits (N, ...): NaN/Inf -> +0, beyond the bound (the
+    column's weight bound, or 1 for the command) -> +-bound. Returns (repaired bits, any repair per row)."""
     m = bits & ABS_MASK
     over = m > bound_bits
     fixed = np.where(m >= EXP_MASK, U32(0), (bits & SIGN_MASK) | bound_bits)
@@ -146,22 +147,38 @@ def law(k: Constants32, inp):
     return e1 + e2, z, vp, rho, result_ok, trig
 
 
-def basis(k: Constants32, e):
+def _gaussians(k: Constants32, s1, s2, c3):
+    """exp(max(min(-d_j / (2 sigma^2), 0), -87)), d_j = (S2 - 2 c_j S1) + c3_j for every node j (the C clamps
+    on the bits, <name>_exponent: the same values for every t that is not NaN, -0 included)."""
+    phi = []
+    for j in range(k.nodes):
+        t = ((s2 - k.basis_c2[j] * s1) + c3[j]) * k.neg_inv_2s2
+        t = np.where(t >= F32(-87.0), t, F32(-87.0))
+        t = np.where(t <= F32(0.0), t, F32(0.0))
+        phi.append(f32(detmath.expf(f32(t)), "phi"))
+    return phi
+
+
+def basis(k: Constants32, e, command=None):
     """phi_j = exp(max(min(-d_j / (2 sigma^2), 0), -87)), d_j = sum_i (x_i - c_j)^2 = (S2 - 2 c_j S1) + 12 c_j^2,
-    x = e / s: S1 = sum x_i, S2 = sum x_i^2 (left to right)."""
+    x = e / s: S1 = sum x_i, S2 = sum x_i^2 (left to right). With the (repaired) previous command u (6
+    columns): also the second network's phi_Delta_j on the 18 inputs [x; u], S1 and S2 continued over u,
+    d_j = (S2' - 2 c_j S1') + 18 c_j^2 (= phi_j exp(-|u - c_j|^2 / (2 sigma^2)) mathematically).
+    Returns (phi, phi_Delta or None)."""
     s1 = f32(e[0] * k.inv_scale[0])
     s2 = s1 * s1
     for i in range(1, 12):
         x = f32(e[i] * k.inv_scale[i])
         s1 = s1 + x
         s2 = s2 + x * x
-    phi = []
-    for j in range(k.nodes):
-        t = ((s2 - k.basis_c2[j] * s1) + k.basis_c3[j]) * k.neg_inv_2s2
-        t = np.where(t >= F32(-87.0), t, F32(-87.0))
-        t = np.where(t <= F32(0.0), t, F32(0.0))
-        phi.append(f32(detmath.expf(f32(t)), "phi"))
-    return phi
+    phi = _gaussians(k, s1, s2, k.basis_c3)
+    if command is None:
+        return phi, None
+    for m in range(6):
+        u = np.ascontiguousarray(command[:, m])
+        s1 = s1 + u
+        s2 = s2 + u * u
+    return phi, _gaussians(k, s1, s2, k.basis_c3d)
 
 
 def adapt(k: Constants32, w, phi, z, a, b):
@@ -194,16 +211,17 @@ def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray
     with np.errstate(all="ignore"):
         th_bits, rep1 = repair(np.ascontiguousarray(state["theta"]).view(U32).reshape(n, k.nodes, 6), bound)
         td_bits, rep2 = repair(np.ascontiguousarray(state["theta_delta"]).view(U32).reshape(n, k.nodes, 6), bound)
-        repaired = rep1 | rep2
-        theta, theta_d = th_bits.view(F32), td_bits.view(F32)
+        cmd_bits, rep3 = repair(np.ascontiguousarray(state["command"]).view(U32).reshape(n, 6), ONE_BITS)
+        repaired = rep1 | rep2 | rep3
+        theta, theta_d, command = th_bits.view(F32), td_bits.view(F32), cmd_bits.view(F32)
         box = in_box(k, inp)
         e, z, vp, rho, result_ok, t = law(k, inp)
         ok = box & result_ok
-        phi = basis(k, e)
+        phi, phi_d = basis(k, e, command if k.theorem == 2 else None)   # theorem 1: the command never read
         wh, theta_new, hit = adapt(k, theta, phi, z, k.a, k.b)
         v = [f32(vp[i] - wh[i]) for i in range(6)]
         if k.theorem == 2:
-            whd, theta_d_new, hit_d = adapt(k, theta_d, phi, z, k.a_d, k.b_d)
+            whd, theta_d_new, hit_d = adapt(k, theta_d, phi_d, z, k.a_d, k.b_d)
             v = [f32(v[i] - whd[i]) for i in range(6)]
             hit |= hit_d
         else:
@@ -236,6 +254,9 @@ def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray
         status |= np.where(hit, U32(STATUS_WEIGHT_BOUND), U32(0))
         status = np.where(ok, status, U32(STATUS_INVALID_INPUT))
         status |= np.where(repaired, U32(STATUS_STATE_REPAIRED), U32(0))
+        # the next step's command input: this step's limited output normalised (|.| <= 1, emit.constants32)
+        cmd_new = [f32(force[i] * k.inv_force_max) for i in range(3)] + [f32(torque[i] * k.inv_torque_max)
+                                                                          for i in range(3)]
     out = np.zeros(n, dtype=rec.OUTPUT_DTYPE)
     zero = F32(0.0)
     for i in range(3):
@@ -247,4 +268,6 @@ def step(k: Constants32, state: np.ndarray, inp: np.ndarray) -> tuple[np.ndarray
     new_state = np.zeros(n, dtype=sdt)
     new_state["theta"] = np.where(ok[:, None, None], theta_new, theta).reshape(n, -1)
     new_state["theta_delta"] = np.where(ok[:, None, None], theta_d_new, theta_d).reshape(n, -1)
+    for i in range(6):    # an invalid step: command 0 (the output was 0)
+        new_state["command"][:, i] = np.where(ok, cmd_new[i], zero)
     return out, new_state

@@ -8,7 +8,7 @@ from codegen.unit import FieldDoc, StatusBit
 from codegen.units.rbf import records
 from codegen.units.rbf.params import ANGLE_MAX, RbfParams
 
-INVALID = "outside it or non-finite: zero force, torque and w_hat, weights unchanged, STATUS_INVALID_INPUT"
+INVALID = "outside it or non-finite: zero force, torque and w_hat, weights unchanged, command 0, STATUS_INVALID_INPUT"
 LOS = "LOS frame (x_l along the line of sight, C_li = Rz(q_eps) Ry(q_beta))"
 
 
@@ -22,10 +22,10 @@ def field_docs(p: RbfParams) -> dict[str, list[FieldDoc]]:
     speed, rate, acc = _num(p.speed_max), _num(p.rate_max), _num(p.accel_max)
     angles = f"|q_eps| <= {tilt}, |q_beta| <= {ang} rad"
     euler = f"|phi| <= {tilt}, |theta|, |psi| <= {ang} rad"
-    wo, wa = _num(p.theta_max_orbit), _num(p.theta_max_attitude)
-    bound = (f"|theta[6 j + k]| <= theta_max_orbit = {wo} for k = 0..2 (orbit columns), <= theta_max_attitude = "
-             f"{wa} for k = 3..5 (attitude columns), after every step; on entry a non-finite weight is reset to 0 "
-             f"and one beyond its bound clipped to it (STATUS_STATE_REPAIRED)")
+    wmax = ", ".join(_num(x) for x in p.theta_max)
+    bound = (f"|theta[6 j + k]| <= theta_max[k], one bound per channel k, theta_max = ({wmax}), after every "
+             f"step; on entry a non-finite weight is reset to 0 and one beyond its bound clipped to it "
+             f"(STATUS_STATE_REPAIRED)")
     return {
         "input": [
             FieldDoc("los", "m, rad", LOS, f"{rho}, {angles}; {INVALID}",
@@ -53,8 +53,8 @@ def field_docs(p: RbfParams) -> dict[str, list[FieldDoc]]:
                      "(STATUS_TORQUE_LIMITED when clipped); 0 on STATUS_INVALID_INPUT",
                      "commanded torque J_n v_att; hold it for the control period"),
             FieldDoc("w_hat", "m/s^2, rad/s^2 (channels rho, q_eps, q_beta, phi, theta, psi)", "x2-dot channels",
-                     f"always finite, |w_hat_k| <= nodes * theta_max_k ({p.nodes} * {wo} orbit, {p.nodes} * {wa} "
-                     "attitude); 0 on STATUS_INVALID_INPUT",
+                     f"always finite, |w_hat_k| <= nodes * theta_max[k] ({p.nodes} * ({wmax})); 0 on "
+                     "STATUS_INVALID_INPUT",
                      "first network's estimate theta^T phi(e) of the unknown term w, before this step's update"),
             FieldDoc("status", "bits", "-", "OR of the STATUS_* bits below; 0: nominal, nothing limited",
                      "what happened in this step"),
@@ -65,6 +65,12 @@ def field_docs(p: RbfParams) -> dict[str, list[FieldDoc]]:
             FieldDoc("theta_delta", "as theta", "x2-dot channels",
                      bound + ("" if p.theorem == 2 else "; theorem 1: never read or adapted (0 from init)"),
                      "weights of the second network (G Delta_u, theorem 2), same layout (init: 0)"),
+            FieldDoc("command", "1 (force / force_max, torque / torque_max)", "body",
+                     "each entry in [-1, 1] after every step; 0 after STATUS_INVALID_INPUT; on entry a non-finite "
+                     "entry is reset to 0 and one beyond +-1 clipped to +-1 (STATUS_STATE_REPAIRED)"
+                     + ("" if p.theorem == 2 else "; theorem 1: stored, never read"),
+                     "this step's limited output normalised: the next step's input of the second network "
+                     "(init: 0)"),
         ],
     }
 
@@ -73,14 +79,14 @@ def status_bits() -> list[StatusBit]:
     return [
         StatusBit("STATUS_INVALID_INPUT", records.STATUS_INVALID_INPUT,
                   "an input outside the valid box or non-finite (or the law's intermediate result beyond 1e30): "
-                  "zero force, torque and w_hat, weights unchanged; caller: FDIR on the navigation source if it "
-                  "persists"),
+                  "zero force, torque and w_hat, weights unchanged, command 0; caller: FDIR on the navigation source "
+                  "if it persists"),
         StatusBit("STATUS_FORCE_LIMITED", records.STATUS_FORCE_LIMITED, "a force component was clipped to force_max"),
         StatusBit("STATUS_TORQUE_LIMITED", records.STATUS_TORQUE_LIMITED,
                   "a torque component was clipped to torque_max"),
         StatusBit("STATUS_WEIGHT_BOUND", records.STATUS_WEIGHT_BOUND,
                   "the adaptation clipped a weight to its bound; telemetry (persistent: the bound is active)"),
         StatusBit("STATUS_STATE_REPAIRED", records.STATUS_STATE_REPAIRED,
-                  "on entry a weight was non-finite (reset to 0) or beyond its bound (clipped); caller: the state "
-                  "memory was corrupted (FDIR)"),
+                  "on entry a weight or command entry was non-finite (reset to 0) or beyond its bound (clipped); "
+                  "caller: the state memory was corrupted (FDIR)"),
     ]

@@ -21,19 +21,18 @@ from codegen.errors import CodegenError
 
 NODES_MIN, NODES_MAX = 2, 15      # 15 nodes: 90 weights per network, well inside the 64 KB CCM
 GAMMA_MAX = 1e4                  # adaptive gains gamma, gamma_delta
-THETA_MAX_MAX = 1e6              # weight bounds theta_max_orbit, theta_max_attitude
+THETA_MAX_MAX = 1e6              # weight bounds theta_max[k]
 
 
 class RbfParamsError(CodegenError):
     """A bad RBF-law parameter (file): missing/unknown key, bad value, unreadable file."""
 
 
-_VECTOR_KEYS = {"k1": 6, "k2": 6, "input_scale": 12, "inertia": 3}
-_POSITIVE_KEYS = ("k3", "lambda", "delta", "gamma", "gamma_delta", "sigma", "mass", "force_max", "torque_max",
-                  "theta_max_orbit", "theta_max_attitude")
+_VECTOR_KEYS = {"k1": 6, "k2": 6, "input_scale": 12, "inertia": 3, "theta_max": 6}
+_POSITIVE_KEYS = ("k3", "lambda", "delta", "gamma", "gamma_delta", "sigma", "mass", "force_max", "torque_max")
 _REQUIRED_KEYS = ("theorem", "k1", "k2", "k3", "alpha", "lambda", "delta", "gamma", "gamma_delta", "nodes",
                   "centre_span", "sigma", "input_scale", "mass", "inertia", "force_max", "torque_max",
-                  "theta_max_orbit", "theta_max_attitude")
+                  "theta_max")
 # the box of valid inputs (docs/rbf-backstepping.md section 11): outside it the step refuses
 _LIMIT_KEYS = ("rho_min", "rho_max", "tilt_max", "speed_max", "rate_max", "accel_max")
 _OPTIONAL_KEYS = _LIMIT_KEYS
@@ -57,9 +56,10 @@ class RbfParams:
     input_scale        12 scales s_i: the RBF input is e_i / s_i.
     mass, inertia      nominal chaser mass (kg) and diagonal inertia (kg*m^2) the law uses.
     force_max          thrust limit per body axis (N); torque_max torque limit per body axis (N*m).
-    theta_max_orbit    weight bound of the three orbit columns (m/s^2, rad/s^2 per unit basis value);
-    theta_max_attitude weight bound of the three attitude columns (rad/s^2).
-                       gamma, gamma_delta <= GAMMA_MAX and the bounds <= THETA_MAX_MAX: with the generated
+    theta_max          6 weight bounds, one per channel k: |theta_jk| <= theta_max[k] and the same for
+                       theta_delta (units of that channel's x2-dot per unit basis value: m/s^2 for rho,
+                       rad/s^2 for the others). gamma, gamma_delta <= GAMMA_MAX and each bound
+                       <= THETA_MAX_MAX: with the generated
                        step's result guard nothing in a valid step can overflow (codegen/units/rbf/emit.py).
     rho_min..accel_max the box of valid inputs: rho and rho_d in [rho_min, rho_max] m; |q_eps|, |q_eps_d|,
                        |phi|, |phi_f| <= tilt_max rad; |range rates| <= speed_max m/s; |angular rates|
@@ -83,8 +83,7 @@ class RbfParams:
     inertia: tuple[float, float, float]
     force_max: float
     torque_max: float
-    theta_max_orbit: float
-    theta_max_attitude: float
+    theta_max: tuple[float, ...]
     rho_min: float = 1.0
     rho_max: float = 10_000.0
     tilt_max: float = 1.2
@@ -142,8 +141,8 @@ def _validate(p: RbfParams) -> None:
     # the adaptation's a = T gamma and the weight bounds
     for key in ("gamma", "gamma_delta"):
         values.float32_in(_value(p, key), f"'{key}'", 0.0, GAMMA_MAX, low_open=True, error=RbfParamsError)
-    for key in ("theta_max_orbit", "theta_max_attitude"):
-        values.float32_in(_value(p, key), f"'{key}'", 0.0, THETA_MAX_MAX, low_open=True, error=RbfParamsError)
+    for i, x in enumerate(p.theta_max):
+        values.float32_in(x, f"'theta_max'[{i}]", 0.0, THETA_MAX_MAX, low_open=True, error=RbfParamsError)
     # the leakage factor 1 - period*gamma*lambda stays in (0, 1] for any period <= 1 s
     if p.gamma * p.lam >= 1.0 or p.gamma_delta * p.lam >= 1.0:
         raise RbfParamsError(f"'gamma'*'lambda' and 'gamma_delta'*'lambda' must be < 1 (got {p.gamma * p.lam:g}, "
@@ -196,7 +195,7 @@ PAPER_MAPPING = {
     "nodes": 7, "centre_span": 1.5, "sigma": 1.0,
     "input_scale": [100.0, 0.2, 0.2, 0.2, 0.2, 0.2, 10.0, 0.05, 0.05, 0.1, 0.1, 0.1],
     "mass": 100.0, "inertia": [11.0, 13.2, 15.4], "force_max": 200.0, "torque_max": 0.5,
-    "theta_max_orbit": 1.0, "theta_max_attitude": 0.1,
+    "theta_max": [0.1, 0.001, 0.001, 0.01, 0.01, 0.01],
 }
 
 
@@ -211,4 +210,4 @@ def example_params() -> RbfParams:
         **PAPER_MAPPING, "k1": [0.3, 0.06, 0.12, 0.9, 1.1, 3.0], "k2": [5.0, 2.5, 2.0, 0.9, 0.5, 0.6],
         "k3": 1e-5, "alpha": 0.7, "lambda": 0.02, "delta": 0.02, "gamma": 2.0, "gamma_delta": 0.5,
         "nodes": 5, "centre_span": 1.2, "sigma": 0.8, "mass": 80.0, "inertia": [8.0, 9.0, 10.0],
-        "force_max": 150.0, "torque_max": 0.4, "theta_max_orbit": 0.8, "theta_max_attitude": 0.05})
+        "force_max": 150.0, "torque_max": 0.4, "theta_max": [0.08, 0.002, 0.002, 0.02, 0.02, 0.02]})

@@ -14,13 +14,14 @@ OUTPUT_DTYPE = np.dtype([("force", *V3), ("torque", *V3), ("w_hat", "<f4", (6,))
 
 # status bits (several may be set; 0 = nominal, nothing limited)
 STATUS_OK = 0
-STATUS_INVALID_INPUT = 1      # outside the valid box: zero output, weights unchanged
+STATUS_INVALID_INPUT = 1      # outside the valid box: zero output, weights unchanged, command 0
 STATUS_FORCE_LIMITED = 2      # a force component was clipped to +-force_max
 STATUS_TORQUE_LIMITED = 4     # a torque component was clipped to +-torque_max
 STATUS_WEIGHT_BOUND = 8       # the adaptation clipped a weight to its bound
-STATUS_STATE_REPAIRED = 16    # on entry a weight was non-finite (reset to 0) or beyond its bound (clipped)
+STATUS_STATE_REPAIRED = 16    # on entry a state word was non-finite (reset to 0) or beyond its bound (clipped)
 
 
 def state_dtype(nodes: int) -> np.dtype:
-    """theta[j*6 + k], theta_delta[j*6 + k]: node j, channel k."""
-    return np.dtype([("theta", "<f4", (nodes * 6,)), ("theta_delta", "<f4", (nodes * 6,))])
+    """theta[j*6 + k], theta_delta[j*6 + k]: node j, channel k; command[6]: the last output normalised,
+    (force / force_max, torque / torque_max), each in [-1, 1] (the second network's input)."""
+    return np.dtype([("theta", "<f4", (nodes * 6,)), ("theta_delta", "<f4", (nodes * 6,)), ("command", "<f4", (6,))])

@@ -1,5 +1,6 @@
 """Paper 002's RBF adaptive finite-time backstepping law (docs/rbf-backstepping.md section 11) as a
-generated unit: state {theta, theta_delta} (the weights, adapted on board), input {the measured and
+generated unit: state {theta, theta_delta, command} (the weights, adapted on board, and the last output
+normalised, the second network's input), input {the measured and
 desired line of sight and attitude with their derivatives}, output {force, torque, w_hat, status};
 parameters and control period baked in as float32 constants.
 """
@@ -13,10 +14,10 @@ from codegen.units.rbf import golden, interface, records, vectors
 from codegen.units.rbf.emit import DEFAULT_NAME, DEFAULT_PERIOD, check_period, constants32, params_sha256, rbf_sources
 from codegen.units.rbf.params import RbfParams
 
-# SPEC section 8: the theorem-2 step at the default 7 nodes, ideal memory (measured 2026-11-27: static
-# bound 5,571). RAM: the constant tables copied to CCM (3,200 B, the power table 3,080 of them) + the
-# caller-owned weights (336 B at 7 nodes), measured 3,536 B; stack measured 448 B (SPEC's 512 B for the
-# whole controller is the ceiling).
+# SPEC section 8: the theorem-2 step at the default 7 nodes, ideal memory (measured 2026-11-27 with the
+# command input: static bound 5,734). RAM: the constant tables copied to CCM (3,200 B, the power table 3,080
+# of them) + the caller-owned state (weights 336 B at 7 nodes, command 24 B), measured 3,560 B; stack
+# measured 448 B (SPEC's 512 B for the whole controller is the ceiling).
 BUDGETS = Budgets(cycles=6_000, flash=None, ram=4_096, stack=512)
 STATUS_NAMES = ((records.STATUS_INVALID_INPUT, "invalid"), (records.STATUS_FORCE_LIMITED, "force limited"),
                 (records.STATUS_TORQUE_LIMITED, "torque limited"), (records.STATUS_WEIGHT_BOUND, "weight bound"),
@@ -70,7 +71,7 @@ class RbfUnit(Unit):
         return problems
 
     def check_state(self, state: np.ndarray) -> list[str]:
-        """Every weight finite and within its column's bound."""
+        """Every weight finite and within its column's bound; every command entry finite and in [-1, 1]."""
         bound = self.constants.theta_max
         problems = []
         for name in ("theta", "theta_delta"):
@@ -79,6 +80,11 @@ class RbfUnit(Unit):
                 problems.append(f"non-finite {name}")
             elif np.any(np.abs(w) > bound):
                 problems.append(f"{name} beyond its bound")
+        u = np.asarray(state["command"])
+        if not np.all(np.isfinite(u)):
+            problems.append("non-finite command")
+        elif np.any(np.abs(u) > np.float32(1.0)):
+            problems.append("command beyond [-1, 1]")
         return problems
 
     def describe_outputs(self, out: np.ndarray) -> str:

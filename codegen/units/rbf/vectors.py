@@ -1,15 +1,19 @@
 """Gate input classes and sequences of the generated RBF-law step (independent (state, input) rows):
   inside     typical operating states of the tracking scenario (rho 50-300 m, angles within the box,
-             small rates, errors across Delta) with random weights within their bounds
+             small rates, errors across Delta) with random weights within their bounds and random
+             commands in [-1, 1] (some entries at +-1 exactly, some rows 0 as after init)
   edges      box boundaries exactly, |e1_i| at and around Delta, z_i = 0 (e1_i = e2_i = 0), weights at
-             +-bound, rho at rho_min / rho_max, |q_eps|, |phi| at tilt_max, angle differences across +-pi
+             +-bound, commands at +-1, +-0 and one ulp inside, rho at rho_min / rho_max, |q_eps|, |phi|
+             at tilt_max, angle differences across +-pi
   outside    one field just outside the box (the next float beyond a limit) -> INVALID_INPUT
-  special    NaN, +-Inf, -0, subnormals, +-FLT_MAX in random input and weight positions
-  state      random-bit weights (NaN payloads, Inf, huge, subnormal) with inside inputs: the entry repair
-  saturated  large errors and weights at their bounds: force, torque and weight clipping
+  special    NaN, +-Inf, -0, subnormals, +-FLT_MAX in random input, weight and command positions
+  state      random-bit weights and commands (NaN payloads, Inf, huge, subnormal, beyond +-1) with inside
+             inputs: the entry repair
+  saturated  large errors, weights at their bounds, commands at +-1: force, torque and weight clipping
 Sequences: smooth synthetic trajectories of the tracking scenario (open loop: the inputs do not
-respond to the outputs) over which the weights adapt from 0; a persistent error in some of them
-drives weights into their bounds.
+respond to the outputs) over which the weights adapt from 0; the command (the state's last output)
+is carried from step to step inside the unit; a persistent error in some of them drives weights
+into their bounds. State rows are float32 words: theta, theta_delta (6 nodes words each), command (6).
 """
 from __future__ import annotations
 
@@ -82,16 +86,31 @@ def _weights(k: Constants32, rng, n: int, fraction: float = 0.5) -> np.ndarray:
     return (rng.uniform(-1.0, 1.0, (n, bound.size)) * fraction * bound).astype(F32)
 
 
-def _theorem1_state(k: Constants32, w: np.ndarray) -> np.ndarray:
-    if k.theorem == 1:       # theta_delta stays 0 under theorem 1 (any value is repaired, never read)
+def _commands(rng, n: int) -> np.ndarray:
+    """(n, 6) float32 commands in [-1, 1]: uniform, a fifth of the entries at +-1 exactly (a limited
+    output), a tenth of the rows 0 (after init or an invalid step)."""
+    u = rng.uniform(-1.0, 1.0, (n, 6))
+    u = np.where(rng.random((n, 6)) < 0.2, np.sign(u), u)
+    u[rng.random(n) < 0.1] = 0.0
+    return u.astype(F32)
+
+
+def _state(k: Constants32, w: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """State rows from weights (n, 12 nodes) and commands (n, 6); theta_delta stays 0 under theorem 1 (any
+    value is repaired, never read)."""
+    w = np.array(w, dtype=F32)
+    if k.theorem == 1:
         w[:, 6 * k.nodes:] = 0.0
-    return w
+    return np.concatenate([w, np.asarray(u, dtype=F32)], axis=1)
+
+
+def _inside_weights(k, rng, n):
+    """Weights from freshly adapted (|theta| ~ 1e-5 bound) to half the bound, row by row."""
+    return _weights(k, rng, n, 1.0) * np.exp(rng.uniform(np.log(1e-5), np.log(0.5), (n, 1))).astype(F32)
 
 
 def _class_inside(k, rng, n):
-    """Weights from freshly adapted (|theta| ~ 1e-5 bound) to half the bound, row by row."""
-    w = _weights(k, rng, n, 1.0) * np.exp(rng.uniform(np.log(1e-5), np.log(0.5), (n, 1))).astype(F32)
-    return _theorem1_state(k, w.astype(F32)), _operating(k, rng, n)
+    return _state(k, _inside_weights(k, rng, n), _commands(rng, n)), _operating(k, rng, n)
 
 
 def _limits(k: Constants32) -> dict[int, tuple[float, float]]:
@@ -102,7 +121,7 @@ def _limits(k: Constants32) -> dict[int, tuple[float, float]]:
 
 
 def _class_edges(k, rng, n):
-    state, x = _class_inside(k, rng, n)
+    w, u, x = _inside_weights(k, rng, n), _commands(rng, n), _operating(k, rng, n)
     lim = _limits(k)
     keys = sorted(lim)
     quarter = n // 4
@@ -141,9 +160,13 @@ def _class_edges(k, rng, n):
         x[r, _index(m, j)] = -np.sign(x[r, _index(dd, j)]) * rng.uniform(2.9, 3.5)
     # weights at +-bound exactly
     bound = np.tile(k.theta_max, 2 * k.nodes)
-    at = rng.random(state.shape) < 0.3
-    state = np.where(at, bound * rng.choice(np.array([-1.0, 1.0], dtype=F32), state.shape), state).astype(F32)
-    return _theorem1_state(k, state), x
+    at = rng.random(w.shape) < 0.3
+    w = np.where(at, bound * rng.choice(np.array([-1.0, 1.0], dtype=F32), w.shape), w).astype(F32)
+    # command entries at +-1, +-0 and one ulp inside +-1
+    edge = np.array([1.0, -1.0, 0.0, -0.0, np.nextafter(F32(1.0), F32(0.0)), -np.nextafter(F32(1.0), F32(0.0))],
+                    dtype=F32)
+    u = np.where(rng.random(u.shape) < 0.5, edge[rng.integers(0, edge.size, u.shape)], u).astype(F32)
+    return _state(k, w, u), x
 
 
 def _class_outside(k, rng, n):
@@ -173,11 +196,17 @@ def _class_special(k, rng, n):
 
 def _class_state(k, rng, n):
     _, x = _class_inside(k, rng, n)
-    words = rng.integers(0, 2 ** 32, size=(n, 12 * k.nodes), dtype=np.uint64).astype(np.uint32)
+    words = rng.integers(0, 2 ** 32, size=(n, 12 * k.nodes + 6), dtype=np.uint64).astype(np.uint32)
     state = words.view(F32).copy()
-    keep = rng.random(state.shape) < 0.7         # most weights valid, some rows entirely valid
-    state = np.where(keep, _weights(k, rng, n, 1.0), state)
-    state[: n // 10] = _weights(k, rng, n // 10, 1.0)
+    # a third of the rows: garbage commands just beyond +-1, NaN or Inf (random bits are mostly far beyond)
+    beyond = np.array([np.nextafter(F32(1.0), F32(2.0)), -np.nextafter(F32(1.0), F32(2.0)), 1.5, -3e38, np.nan,
+                       np.inf, -np.inf], dtype=F32)
+    rows = rng.random(n) < 0.3
+    state[rows, 12 * k.nodes:] = beyond[rng.integers(0, beyond.size, (int(rows.sum()), 6))]
+    valid = np.concatenate([_weights(k, rng, n, 1.0), _commands(rng, n)], axis=1)
+    keep = rng.random(state.shape) < 0.7         # most words valid, some rows entirely valid
+    state = np.where(keep, valid, state)
+    state[: n // 10] = valid[: n // 10]
     return state, x
 
 
@@ -185,6 +214,8 @@ def _class_saturated(k, rng, n):
     state = _weights(k, rng, n, 1.0)
     bound = np.tile(k.theta_max, 2 * k.nodes)
     state = np.where(rng.random(state.shape) < 0.5, bound * np.sign(state), state).astype(F32)
+    u = _commands(rng, n)
+    u = np.where(rng.random(u.shape) < 0.7, np.where(u < 0.0, F32(-1.0), F32(1.0)), u).astype(F32)   # limited
     x = _operating(k, rng, n, err_scale=1.0)
     # large range and attitude errors, fast rates
     x[:, _index("los", 0)] = np.where(rng.random(n) < 0.5, 300.0, 50.0)
@@ -201,7 +232,7 @@ def _class_saturated(k, rng, n):
     w = state[:half].reshape(half, 2, k.nodes, 6)
     sign = np.where(c >= 0.0, 1.0, -1.0).astype(F32)
     w[np.arange(half), :, node, :] = (sign[:, None, None] * k.theta_max[None, None, :]).astype(F32)
-    return _theorem1_state(k, state), x
+    return _state(k, state, u), x
 
 
 def _at_node(k: Constants32, x: np.ndarray, c: np.ndarray) -> None:

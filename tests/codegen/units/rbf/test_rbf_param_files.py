@@ -42,7 +42,8 @@ def _refused(data: dict) -> str:
     ("tilt_max", 1.5, "'tilt_max': must be in (0, 1.4], got 1.5"),
     ("rho_max", 0.5, "'rho_max': must be in (1, 1e+06], got 0.5"),
     ("gamma", 2e4, "'gamma': must be in (0, 10000], got 20000.0"),
-    ("theta_max_attitude", 2e6, "'theta_max_attitude': must be in (0, 1e+06], got 2000000.0"),
+    ("theta_max", [0.1] * 5 + [2e6], "'theta_max'[5]: must be in (0, 1e+06], got 2000000.0"),
+    ("theta_max", [0.1] * 5 + [0.0], "'theta_max'[5]: must be > 0, got 0.0"),
     ("mass", 3.5e38, "'mass': must be finite (and within float32)"),
     pytest.param("force_max", 10 ** 400, "'force_max': must be finite (and within float32)", id="400-digits"),
     ("theorem", 3, "'theorem': must be in [1, 2], got 3"),
@@ -62,6 +63,8 @@ def test_ranges_hold_after_rounding_to_float32(key, value, message):
     ("k2", "6.5", "'k2': must be a list of 6 numbers"),
     ("input_scale", [1.0] * 11, "'input_scale': must be a list of 12 numbers"),
     ("inertia", [11.0, 13.2, -1.0], "'inertia'[2]: must be > 0, got -1.0"),
+    ("theta_max", 0.1, "'theta_max': must be a list of 6 numbers"),
+    ("theta_max", [0.1, 0.01], "'theta_max': must be a list of 6 numbers"),
 ])
 def test_numbers_only_and_vectors_of_their_length(key, value, message):
     assert message in _refused(_mapping(**{key: value}))
@@ -72,6 +75,9 @@ def test_unknown_and_missing_keys_are_refused():
     data = _mapping()
     del data["k2"]
     assert _refused(data) == "missing key 'k2'"
+    old = _mapping(theta_max_orbit=1.0, theta_max_attitude=0.1)     # the two bounds before one per channel
+    del old["theta_max"]
+    assert _refused(old) == "unknown key 'theta_max_attitude'"
     assert "must be a table/object" in _refused([1, 2])
 
 
