@@ -201,7 +201,7 @@ def commands(p: RbfParams, m: LosMeasurement, v: np.ndarray) -> tuple[np.ndarray
 
 
 def weight_bounds(p: RbfParams) -> np.ndarray:
-    return np.array([p.theta_max_orbit] * 3 + [p.theta_max_attitude] * 3)
+    return np.asarray(p.theta_max, dtype=float)
 
 
 def adapt(p: RbfParams, weights: np.ndarray, phi: np.ndarray, z: np.ndarray, gain: float,

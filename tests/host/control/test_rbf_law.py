@@ -116,7 +116,7 @@ def test_theorem1_z_dynamics_close_as_designed():
     s0 = _state_at(tau0)
     m0 = _measurement(s0, tau0)
     out, _ = law.step(P, law.initial_state(P), m0)
-    assert out.status == law.STATUS_OK
+    assert out.status & ~law.STATUS_WEIGHT_BOUND == law.STATUS_OK     # no limit acted on this step's output
     terms = law.tracking_terms(P, m0)
     assert np.all(np.abs(terms.e1) > P.delta)
     z_plus = law.tracking_terms(P, _measurement(_flow(s0, h, out.force, out.torque), tau0 + h)).z
@@ -147,13 +147,13 @@ def test_weights_stay_within_their_bound_and_the_bound_is_reported():
     phi = np.ones(p.nodes)
     z = np.array([50.0, -3.0, 0.001, 9.0, -9.0, 0.0])
     theta, hit = law.adapt(p, np.zeros((p.nodes, 6)), phi, z, p.gamma, 0.1)
-    bound = np.array([p.theta_max_orbit] * 3 + [p.theta_max_attitude] * 3)
+    bound = np.array([0.1, 0.001, 0.001, 0.01, 0.01, 0.01])     # docs/rbf_paper002.toml
     assert hit
     np.testing.assert_array_equal(theta[0], np.clip(0.1 * z, -bound, bound))
     # a small update is the leaky Euler step, unclipped: (1 - T gamma lambda) theta + T gamma phi z
-    theta2, hit2 = law.adapt(p, theta, 0.5 * phi, 1e-3 * np.ones(6), p.gamma, 0.1)
+    theta2, hit2 = law.adapt(p, theta, 0.5 * phi, 1e-4 * np.ones(6), p.gamma, 0.1)
     assert not hit2
-    np.testing.assert_allclose(theta2, (1 - 0.1 * p.lam) * theta + 0.1 * 0.5e-3, rtol=1e-15)
+    np.testing.assert_allclose(theta2, (1 - 0.1 * p.lam) * theta + 0.1 * 0.5e-4, rtol=1e-15)
 
 
 def test_the_second_network_sees_the_last_command():
@@ -189,7 +189,7 @@ def test_weights_never_leave_the_bound_over_saturated_steps():
         out, state = law.step(p, state, m)
     assert out.status & law.STATUS_WEIGHT_BOUND and out.status & law.STATUS_FORCE_LIMITED
     for w in (state.theta, state.theta_delta):
-        assert np.all(np.abs(w[:, :3]) <= p.theta_max_orbit) and np.all(np.abs(w[:, 3:]) <= p.theta_max_attitude)
+        assert np.all(np.abs(w) <= np.array(p.theta_max))
     assert np.max(np.abs(out.force)) == p.force_max
 
 
