@@ -37,6 +37,9 @@ class RbfUnit(Unit):
         return (f"rbf law ({self.step_symbol}), theorem {self.params.theorem}, {self.params.nodes} nodes, period "
                 f"{self.period:g} s, params sha256 {params_sha256(self.params, self.period)[:16]}")
 
+    def values_sha256(self) -> str:
+        return params_sha256(self.params, self.period)
+
     def sources(self) -> dict[str, str]:
         return dict(self._sources)
 

@@ -16,7 +16,7 @@ import pytest
 import host.cli as cli
 from codegen.unit import Batch
 from codegen.units.rbf import records as rec
-from codegen.units.rbf.params import example_params, load_params, params_from_mapping
+from codegen.units.rbf.params import example_params, load_params, paper_params, params_from_mapping
 from codegen.units.rbf.unit import RbfUnit
 from tools.gate import compare_fields
 from tools.runners import runner
@@ -438,3 +438,13 @@ def test_the_fuzzer_holds_the_weights_to_their_bounds():
     planted.check_state = lambda state: ["planted"] if state.shape[0] else []
     result = fuzz(planted, 1_000, seed=3, log=lambda *_: None)
     assert result.mismatches == 0 and result.invariant_problems == ["planted"]
+
+
+def test_the_package_records_the_values_it_bakes_in():
+    """values_sha256 (the manifest's record of the parameter file) changes with any baked-in value: a
+    gain, the period; and not with how the file wrote a number."""
+    p = paper_params()
+    base = RbfUnit(p, 0.1).values_sha256()
+    assert len(base) == 64 and base == RbfUnit(paper_params(k3=1e-07), 0.1).values_sha256()
+    assert base != RbfUnit(p, 0.05).values_sha256()
+    assert base != RbfUnit(paper_params(k3=2e-7), 0.1).values_sha256()
