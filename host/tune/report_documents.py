@@ -71,6 +71,16 @@ CALIBRATION = {
                           "critically_damped_for_paper_nn_settling": {"settling_s": XYZ, "kp": XYZ, "kd": XYZ}}),
 }
 
+# `staregen simulate --controller rbf|rbf-c|rbf-arm` (host.sim.rbf_example): the fields the report reads
+MAYBE_TIME = Maybe(NONNEG)
+RBF_RUN = {
+    "controller": TEXT, "theorem": COUNT, "period": POSITIVE, "duration": POSITIVE,
+    "t_rho_5m": MAYBE_TIME, "t_rho_1m": MAYBE_TIME, "t_attitude_1deg": ListOf(MAYBE_TIME, 3),
+    "delta_v": NONNEG, "torque_impulse": NONNEG, "min_rho": REAL, "weight_bound_active_steps": COUNT,
+    "rms_e1?": ListOf(NONNEG, 6), "golden_mismatch_steps?": COUNT, "max_rho_diff_m?": NONNEG,
+    "max_attitude_diff_deg?": NONNEG, "cycles_max?": COUNT,
+}
+
 
 def _label(value) -> str:
     """A value for an error line: short, on one line (a container by its type)."""

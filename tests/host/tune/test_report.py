@@ -151,3 +151,48 @@ def test_the_fidelity_section_holds_the_calibration_escaped(tmp_path):
     assert "5e-04" not in p.cells and _g(5e-4) in p.cells and _g(PAPER_TABLE9["NN"][2]) in p.cells
     (cal / "calibration.json").write_text("{}")
     assert main(["report", "--evaluate", str(ev), "--calibration", str(cal), "--out", str(tmp_path / "r2")]) == 2
+
+
+RBF_METRICS = {"controller": "rbf-c", "theorem": 2, "period": 0.1, "duration": 1000.0, "t_rho_5m": 28.6,
+               "t_rho_1m": 36.0, "t_attitude_1deg": [5.4, 3.3, 2.7], "delta_v": 306.0, "torque_impulse": 17.2,
+               "min_rho": 51.7, "weight_bound_active_steps": 12, "rms_e1": [5.1e-5, 1e-6, 7e-7, 4e-6, 1e-5, 3e-6],
+               "golden_mismatch_steps": 0, "max_rho_diff_m": 1.2e-4, "max_attitude_diff_deg": 2.1e-3}
+
+
+def _rbf_run(folder, **changes):
+    folder.mkdir()
+    (folder / "metrics.json").write_text(json.dumps({**RBF_METRICS, **changes}))
+    return folder
+
+
+def test_the_rbf_section_puts_paper_002_beside_each_run(tmp_path):
+    run1 = _rbf_run(tmp_path / "sil")
+    run2 = _rbf_run(tmp_path / "t1", controller="rbf<script>", theorem=1, t_rho_1m=None,
+                    t_attitude_1deg=[5.5, None, 2.8])
+    (run1 / "fig_range_los.png").write_bytes(b"\x89PNG\r\n\x1a\n" + b"0" * 16)
+    assert main(["report", "--rbf", str(run1), "--rbf", str(run2), "--out", str(tmp_path / "r")]) == 0
+    md = (tmp_path / "r" / "report.md").read_text()
+    assert "| paper 002 (§3.2) | 1, 2 | \\- | 22.9 | \\- | 5.7 |" in md
+    assert "| rbf-c | 2 | 0.1 | 28.6 | 36.0 | 5.4 | 306 |" in md
+    assert "0 mismatching steps; \\|Δρ\\| ≤ 0.00012 m" in md
+    assert "| 1 | 0.1 | 28.6 | not reached | not reached |" in md      # a None time is not a number
+    page = Collect()
+    page.feed((tmp_path / "r" / "report.html").read_text())
+    assert "rbf<script>" in page.cells and len(page.imgs) == 1       # escaped text, the one figure
+    assert (tmp_path / "r" / "rbf1_fig_range_los.png").exists()
+    assert "evaluation wall times" not in md
+
+
+def test_bad_rbf_inputs_are_one_line(tmp_path, capsys):
+    assert main(["report", "--out", str(tmp_path / "r")]) == 2
+    assert "give --evaluate DIR, --rbf DIR or both" in capsys.readouterr().err
+    assert main(["report", "--rbf", str(tmp_path / "none"), "--out", str(tmp_path / "r")]) == 2
+    assert "--rbf" in capsys.readouterr().err
+    bad = _rbf_run(tmp_path / "bad", t_rho_5m="soon")
+    assert main(["report", "--rbf", str(bad), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "not written by `staregen simulate --controller rbf`" in err and "t_rho_5m" in err and err.count("\n") == 1
+    good = _rbf_run(tmp_path / "good")
+    assert main(["report", "--rbf", str(good), "--tune", str(good), "--out", str(tmp_path / "r")]) == 2
+    assert "--tune and --calibration need --evaluate" in capsys.readouterr().err
+    assert not (tmp_path / "r").exists()
