@@ -70,12 +70,13 @@ def file_sha256(path: Path) -> str:
 
 
 def generate(cfg: pc.PackageConfig, network: art.Artifact, out: Path, inputs: dict, params: dict | None = None,
-             plan: EvidencePlan = EvidencePlan(), log=print, input_paths=(), sign_key: bytes | None = None):
+             plan: EvidencePlan = EvidencePlan(), log=print, input_paths=(), sign_key: bytes | None = None,
+             units: dict | None = None):
     """The package of a validated configuration and network (also the pipeline's last stage);
-    `params`: {unit: its parameters}; `input_paths`: the files read, which must not lie in the
-    folder it replaces."""
+    `params`: {unit: its parameters}, or `units` already bound by package_units; `input_paths`: the
+    files read, which must not lie in the folder it replaces."""
     check_output_folder(out, package_owner, input_paths)
-    units = package_units(cfg, network, params)
+    units = units if units is not None else package_units(cfg, network, params)
     return build_package(out, cfg.name, units, cfg.to_mapping(), inputs, plan, log, sign_key)
 
 
@@ -118,10 +119,11 @@ def run(args: argparse.Namespace) -> int:
     inputs = {"config": {"file": config_path.name, "sha256": file_sha256(config_path), "values_sha256": cfg.sha256},
               "network": {"file": network_path.name, "sha256": file_sha256(network_path),
                           "payload_sha256": network.sha256, "shape": network.shape_text}}
-    bound = package_units(cfg, network, params)      # refuses a missing or unconfigured unit before any work
+    bound = package_units(cfg, network, params)      # refuses a missing or unconfigured unit before any output
     for unit, path in files.items():
         inputs[unit] = {"file": path.name, "sha256": file_sha256(path), "values_sha256": bound[unit].values_sha256()}
     result = generate(cfg, network, Path(args.out), inputs, params, plan,
-                      input_paths=(args.config, args.network, *files.values(), args.sign_key), sign_key=sign_key)
+                      input_paths=(args.config, args.network, *files.values(), args.sign_key), sign_key=sign_key,
+                      units=bound)
     print("\n".join(summary(result)))
     return 0

@@ -28,6 +28,7 @@ DEFAULT_DURATION_S = 100.0
 MAX_DURATION_S = 100_000.0    # a staring pass lasts minutes; this bounds memory (histories) too
 MIN_PERIOD_S, MAX_PERIOD_S = 1e-4, 10.0
 MIN_DT_S = 1e-6
+TANH_DEFAULT_DURATION_S = 40.0       # paper 000's example
 RBF_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "rbf_paper002.toml"
 RBF_DEFAULT_DURATION_S = 1000.0      # paper 002, section 3.1
 RBF_MAX_DURATION_S = 20_000.0        # ten hours of a 10 Hz loop in Python: a bound on time and memory
@@ -58,7 +59,7 @@ def register(subparsers) -> None:
                    help="discrete-point tables for dp / dp-c (`staregen dp build`)")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
-    p.add_argument("--duration", default=str(DEFAULT_DURATION_S), help="simulated seconds (default 100)")
+    p.add_argument("--duration", default=None, help="simulated seconds (default 100; tanh 40, rbf 1000)")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
     add_scenario_argument(p)
     p.add_argument("--t-img", default="1.0", help="imaging window length T_img in s (default 1)")
@@ -69,7 +70,8 @@ def register(subparsers) -> None:
 
 
 def build_config(args, errors) -> SimConfig:
-    return SimConfig(duration=parse_number(args.duration, "--duration", positive=True, maximum=MAX_DURATION_S),
+    duration = args.duration if args.duration is not None else str(DEFAULT_DURATION_S)
+    return SimConfig(duration=parse_number(duration, "--duration", positive=True, maximum=MAX_DURATION_S),
                      seed=parse_int(args.seed, "--seed"), errors=errors)
 
 
@@ -82,8 +84,8 @@ def run_tanh_example(args: argparse.Namespace) -> int:
     """The paper-000 example (section 4.2) flown by the tanh saturation law; metrics.json + Figs. 5-8.
     tanh: the float64 law (continuous without --period); tanh-c / tanh-arm: the generated C in the
     loop (SIL / PIL, --period default 0.1 s) compared with the float64 sampled run."""
-    duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else "40",
-                            "--duration", positive=True, maximum=MAX_DURATION_S)
+    duration = parse_number(str(TANH_DEFAULT_DURATION_S) if args.duration is None else args.duration, "--duration",
+                            positive=True, maximum=MAX_DURATION_S)
     in_loop = {"tanh-c": "x86", "tanh-arm": "arm"}.get(args.controller)
     period = None if args.period is None else parse_number(args.period, "--period", minimum=MIN_PERIOD_S,
                                                               maximum=MAX_PERIOD_S)
@@ -121,8 +123,8 @@ def run_rbf_example(args: argparse.Namespace) -> int:
     if args.target != "central" or args.scenario is not None:
         raise HostError("--target and --scenario do not apply to the rbf controllers (paper 002's own scenario)")
     params = load_rbf_params(args.params if args.params is not None else RBF_PARAMS)
-    duration = parse_number(args.duration if args.duration != str(DEFAULT_DURATION_S) else str(RBF_DEFAULT_DURATION_S),
-                            "--duration", positive=True, maximum=RBF_MAX_DURATION_S)
+    duration = parse_number(str(RBF_DEFAULT_DURATION_S) if args.duration is None else args.duration, "--duration",
+                            positive=True, maximum=RBF_MAX_DURATION_S)
     period = parse_number(args.period or "0.1", "--period", minimum=0.01, maximum=1.0)
     dt = parse_number(args.dt or "0.01", "--dt", minimum=MIN_DT_S, maximum=period)
     out = Path(args.out)
@@ -137,17 +139,13 @@ def run_rbf_example(args: argparse.Namespace) -> int:
     return 0
 
 
-def _seconds(x) -> str:
-    return "never" if x is None else f"{x:.1f} s"
-
-
 def rbf_summary(m: dict) -> list[str]:
     att = m["t_attitude_1deg"]
     lines = [f"{m['controller']}: paper 002 tracking scenario, theorem {m['theorem']}, T = {m['period']:g} s, "
              f"{m['duration']:g} s" + (f", {m['mode']}" if "mode" in m else ""),
-             f"  range within 5 m / 1 m of 100 m (to stay) {_seconds(m['t_rho_5m'])} / {_seconds(m['t_rho_1m'])}"
+             f"  range within 5 m / 1 m of 100 m (to stay) {rbf_example.format_seconds(m['t_rho_5m'])} / {rbf_example.format_seconds(m['t_rho_1m'])}"
              f"   (paper: 22.9 s); closest approach {m['min_rho']:.1f} m at {m['t_min_rho']:.1f} s",
-             "  attitude within 1 deg (phi, theta, psi)   " + ", ".join(_seconds(x) for x in att)
+             "  attitude within 1 deg (phi, theta, psi)   " + ", ".join(rbf_example.format_seconds(x) for x in att)
              + "   (paper: 5.7 s)",
              f"  delta-v {m['delta_v']:.1f} m/s, torque impulse {m['torque_impulse']:.2f} N*m*s, "
              f"weight bound active {m['weight_bound_active_steps']} steps"]

@@ -45,6 +45,7 @@ from host.errors import HostError
 from host.gnc.los import LosMeasurement, from_record
 
 PERIOD = 0.1        # s, control period (docs section 8)
+RESULT_MAX = 1e30   # the flight unit's result guard on sum |v'| + sum |z| (docs section 13)
 ZERO3 = np.zeros(3)
 
 
@@ -81,6 +82,11 @@ def wrap_difference(d):
 # ----------------------------------------------------------------------------- step 1: valid box
 
 
+def _limit(x: float) -> float:
+    """A limit as the flight unit holds it (float32), so both refuse the same inputs at the box edge."""
+    return float(np.float32(x))
+
+
 def valid_input(p: RbfParams, m: LosMeasurement) -> bool:
     values = np.concatenate([np.ravel(getattr(m, name)) for name in LosMeasurement.__dataclass_fields__])
     if not np.all(np.isfinite(values)):
@@ -88,13 +94,14 @@ def valid_input(p: RbfParams, m: LosMeasurement) -> bool:
     (rho, eps, beta), (rho_d, eps_d, beta_d) = m.los, m.los_d
     (phi, theta, psi), (phi_f, theta_f, psi_f) = m.euler, m.euler_d
     rates = [m.los_rate[1], m.los_rate[2], *m.omega, m.los_d_rate[1], m.los_d_rate[2], *m.euler_d_rate]
+    rho_min, rho_max = _limit(p.rho_min), _limit(p.rho_max)
     return bool(
-        p.rho_min <= rho <= p.rho_max and p.rho_min <= rho_d <= p.rho_max
-        and max(abs(eps), abs(eps_d), abs(phi), abs(phi_f)) <= p.tilt_max
-        and max(abs(beta), abs(theta), abs(psi), abs(beta_d), abs(theta_f), abs(psi_f)) <= ANGLE_MAX
-        and max(abs(m.los_rate[0]), abs(m.los_d_rate[0])) <= p.speed_max
-        and max(abs(r) for r in rates) <= p.rate_max
-        and max(np.max(np.abs(m.los_d_acc)), np.max(np.abs(m.euler_d_acc))) <= p.accel_max)
+        rho_min <= rho <= rho_max and rho_min <= rho_d <= rho_max
+        and max(abs(eps), abs(eps_d), abs(phi), abs(phi_f)) <= _limit(p.tilt_max)
+        and max(abs(beta), abs(theta), abs(psi), abs(beta_d), abs(theta_f), abs(psi_f)) <= _limit(ANGLE_MAX)
+        and max(abs(m.los_rate[0]), abs(m.los_d_rate[0])) <= _limit(p.speed_max)
+        and max(abs(r) for r in rates) <= _limit(p.rate_max)
+        and max(np.max(np.abs(m.los_d_acc)), np.max(np.abs(m.euler_d_acc))) <= _limit(p.accel_max))
 
 
 # ----------------------------------------------------------------------------- steps 2-4: errors, nu, z
@@ -231,6 +238,9 @@ def step(p: RbfParams, state: RbfState, m: LosMeasurement, period: float = PERIO
     w_hat_delta = state.theta_delta.T @ phi_delta if p.theorem == 2 else np.zeros(6)
     F, _ = nominal_model(p, m, t)
     v = control_vector(p, F, t, w_hat + w_hat_delta)
+    if np.sum(np.abs(v + w_hat + w_hat_delta)) + np.sum(np.abs(t.z)) > RESULT_MAX:
+        # the unit's result guard (docs section 13): a law this far out (absurd gains) is refused
+        return invalid_output(), RbfState(state.theta, state.theta_delta, np.zeros(6))
     _, force, torque = commands(p, m, v)
     status = STATUS_OK
     if np.any(np.abs(force) > p.force_max):
@@ -260,6 +270,8 @@ class RbfLaw:
     def __init__(self, params: RbfParams, period: float = PERIOD):
         if not (period > 0 and math.isfinite(period)):
             raise HostError(f"control period must be a positive number of seconds, got {period!r}")
+        if period * max(params.gamma, params.gamma_delta) * params.lam >= 1.0:
+            raise HostError(f"control period {period!r} s: the leakage factor 1 - T*gamma*lambda must stay > 0")
         self.params, self.period = params, float(period)
         self.state = initial_state(params)
 

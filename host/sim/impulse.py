@@ -100,7 +100,7 @@ def plot(r: ImpulseResult, path: Path, label: str) -> Path:
     axm.set_xlabel("t [s]")
     axm.grid(True, lw=0.3)
     fig.tight_layout()
-    return plots._save(fig, path)
+    return plots.save_figure(fig, path)
 
 
 def write(r: ImpulseResult, out: Path, controller: str, scenario: dict | None = None) -> None:

@@ -16,7 +16,7 @@ from codegen import atomic  # noqa: E402
 _AXES = ("x", "y", "z")
 
 
-def _save(fig, path: Path) -> Path:
+def save_figure(fig, path: Path) -> Path:
     with atomic.writing(path, suffix=".png") as tmp:
         fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)
@@ -33,7 +33,7 @@ def _three_axis_plot(t, values, labels, ylabel, title, path) -> Path:
     axes[-1].set_xlabel("t [s]")
     fig.supylabel(ylabel)
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_euler_error(t, A_e_rad, path, title: str = "Euler angle error") -> Path:
@@ -57,4 +57,4 @@ def plot_target_scatter(J_A: Sequence[float], J_w: Sequence[float], path, label:
     ax.grid(True, lw=0.3)
     ax.legend()
     fig.tight_layout()
-    return _save(fig, path)
+    return save_figure(fig, path)

@@ -25,6 +25,7 @@ from codegen.units.rbf.params import RbfParams  # noqa: E402
 from host.core.constants import DEG  # noqa: E402
 from host.errors import HostError  # noqa: E402
 from host.sim import rbf_tracking  # noqa: E402
+from host.sim.plots import save_figure  # noqa: E402
 from host.sim.scenarios import configure_unit  # noqa: E402
 from tools.inloop import InTheLoop  # noqa: E402
 
@@ -129,9 +130,12 @@ def _figure(path: Path, draw, rows: int) -> None:
         ax.grid(True, alpha=0.3)
     axes[-1, 0].set_xlabel("t (s)")
     fig.tight_layout()
-    with atomic.writing(path, suffix=".png") as tmp:
-        fig.savefig(tmp, format="png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
+
+
+def format_seconds(x) -> str:
+    """A band time of the metrics: None (the band is not held at the end) reads 'not reached'."""
+    return "not reached" if x is None else f"{x:.1f} s"
 
 
 def _title(metrics: dict) -> str:

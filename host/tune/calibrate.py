@@ -233,7 +233,7 @@ def plot_ratio_vs_noise(doc: dict, path) -> None:
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    plots._save(fig, path)
+    plots.save_figure(fig, path)
 
 
 def summary_lines(doc: dict) -> list[str]:

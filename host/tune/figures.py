@@ -27,7 +27,7 @@ def fig10_scatter(staring: dict, path: Path) -> Path:
     ax.grid(True, lw=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    return plots._save(fig, path)
+    return plots.save_figure(fig, path)
 
 
 def fig11_12_step(step: dict, path: Path) -> Path:
@@ -45,7 +45,7 @@ def fig11_12_step(step: dict, path: Path) -> Path:
         ax.legend(fontsize=8, ncol=3)
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
-    return plots._save(fig, path)
+    return plots.save_figure(fig, path)
 
 
 def fig13_14_frequency(freq: dict, path: Path) -> Path:
@@ -62,7 +62,7 @@ def fig13_14_frequency(freq: dict, path: Path) -> Path:
     axes[0].set_ylabel("amplitude of A_bd [°]")
     axes[0].legend(fontsize=8)
     fig.tight_layout()
-    return plots._save(fig, path)
+    return plots.save_figure(fig, path)
 
 
 def write_evaluation(result: dict, network: str, seed: int, out: Path, errors: ErrorModel = TABLE6_ERRORS) -> dict:

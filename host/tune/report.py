@@ -23,6 +23,7 @@ from pathlib import Path
 from codegen import atomic
 from codegen.markdown import escape as markdown_escape
 from host.errors import HostError
+from host.sim.rbf_example import format_seconds
 from host.tune import paper001
 from host.tune import report_documents as documents
 
@@ -226,8 +227,9 @@ def fidelity_blocks(evaluation: dict, cal: dict, figure: Path | None) -> list[Bl
     return out
 
 
-def _seconds(x) -> str:
-    return "not reached" if x is None else f"{x:.1f}"
+def _band_time(x) -> str:
+    """Seconds in a table whose header carries the unit (rbf_example.format_seconds without ' s')."""
+    return format_seconds(x).removesuffix(" s")
 
 
 def rbf_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
@@ -237,8 +239,8 @@ def rbf_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
     rows = [("paper 002 (§3.2)", "1, 2", "-", "22.9", "-", "5.7", "lost", "lost", "-", "-")]
     for m in runs:
         rms = m.get("rms_e1")
-        rows.append((m["controller"], str(m["theorem"]), _g(m["period"]), _seconds(m["t_rho_5m"]),
-                     _seconds(m["t_rho_1m"]), _seconds(None if None in m["t_attitude_1deg"] else max(m["t_attitude_1deg"])),
+        rows.append((m["controller"], str(m["theorem"]), _g(m["period"]), _band_time(m["t_rho_5m"]),
+                     _band_time(m["t_rho_1m"]), _band_time(None if None in m["t_attitude_1deg"] else max(m["t_attitude_1deg"])),
                      _g(m["delta_v"]), _g(rms[0]) if rms else "-", _g(m["min_rho"]),
                      "-" if "golden_mismatch_steps" not in m else
                      f"{m['golden_mismatch_steps']} mismatching steps; |Δρ| ≤ {_g(m['max_rho_diff_m'])} m, "

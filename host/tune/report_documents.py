@@ -80,6 +80,7 @@ RBF_RUN = {
     "rms_e1?": ListOf(NONNEG, 6), "golden_mismatch_steps?": COUNT, "max_rho_diff_m?": NONNEG,
     "max_attitude_diff_deg?": NONNEG, "cycles_max?": COUNT,
 }
+RBF_IN_LOOP = ("golden_mismatch_steps", "max_rho_diff_m", "max_attitude_diff_deg")   # all or none
 
 
 def _label(value) -> str:
@@ -189,6 +190,9 @@ def read(path: Path, what: str, shape, writer: str) -> dict:
             _check_frequency_grid(doc)
         if shape is CALIBRATION:
             _check_calibration_labels(doc)
+        if shape is RBF_RUN and 0 < sum(key in doc for key in RBF_IN_LOOP) < len(RBF_IN_LOOP):
+            missing = next(key for key in RBF_IN_LOOP if key not in doc)
+            raise HostError(f"{missing}: missing (a C-in-the-loop run has all of {', '.join(RBF_IN_LOOP)})")
     except HostError as exc:
         raise HostError(f"{path}: not written by `{writer}`: {exc}") from None
     return doc

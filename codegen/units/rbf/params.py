@@ -37,6 +37,9 @@ _REQUIRED_KEYS = ("theorem", "k1", "k2", "k3", "alpha", "lambda", "delta", "gamm
 _LIMIT_KEYS = ("rho_min", "rho_max", "tilt_max", "speed_max", "rate_max", "accel_max")
 _OPTIONAL_KEYS = _LIMIT_KEYS
 _FIELD_OF_KEY = {"lambda": "lam"}
+# The smallest RBF input scale: every error in the valid box (|e_i| <= 2e6) divided by it, squared and
+# summed over the 18 inputs stays finite in float32 (no inf - inf = NaN in the basis distance).
+INPUT_SCALE_MIN = 1e-6
 ANGLE_MAX = 3.5      # |angle| of every non-tilt angle input (rad): one 2*pi wrap brings a difference into [-pi, pi]
 
 
@@ -124,8 +127,9 @@ def _validate(p: RbfParams) -> None:
         v = _value(p, key)
         if not isinstance(v, (list, tuple)) or len(v) != n:
             raise RbfParamsError(f"'{key}': must be a list of {n} numbers, got {values.show(v)}")
+        low = INPUT_SCALE_MIN if key == "input_scale" else 0.0
         for i, x in enumerate(v):
-            values.float32_in(x, f"'{key}'[{i}]", 0.0, low_open=True, error=RbfParamsError)
+            values.float32_in(x, f"'{key}'[{i}]", low, low_open=low == 0.0, error=RbfParamsError)
     for key in _POSITIVE_KEYS + _LIMIT_KEYS:
         values.float32_in(_value(p, key), f"'{key}'", 0.0, low_open=True, error=RbfParamsError)
     values.float32_in(p.alpha, "'alpha'", 0.0, 1.0, low_open=True, high_open=True, error=RbfParamsError)

@@ -8,7 +8,9 @@ import pytest
 
 from host.control import rbf_law as law
 from host.core.rotations import dcm_from_euler312, euler312_rate_matrix_inverse, los_frame
-from host.gnc.los import LosMeasurement, los_kinematics, to_record
+from codegen.units.rbf.params import example_params
+from codegen.units.rbf.unit import RbfUnit
+from host.gnc.los import LosMeasurement, from_record, los_kinematics
 
 # ----------------------------------------------------------------------------- Lemma 1
 
@@ -218,12 +220,41 @@ def test_wrapped_angle_differences():
                                [6.0 - 2 * math.pi, -6.3 + 2 * math.pi, 0.5], atol=1e-15)
 
 
-def test_record_step_matches_the_float64_step_on_the_same_float32_input():
-    p = law.paper_params()
+def test_a_wrapped_difference_reaches_the_step():
+    """q_beta = 3.4 against q_beta_d = -3.4 is 6.8 - 2 pi apart, not 6.8 (and likewise theta, psi)."""
     tau0 = 37.0
     m = _measurement(_state_at(tau0), tau0)
-    rec_out = law.RbfLaw(p).step_record(to_record(m))
-    from host.gnc.los import from_record
-    out = law.RbfLaw(p)(from_record(to_record(m)))
-    np.testing.assert_array_equal(rec_out["force"][0], np.float32(out.force))
-    assert rec_out["status"][0] == out.status
+    m = LosMeasurement(**{**m.__dict__, "los": np.array([m.los[0], m.los[1], 3.4]),
+                          "los_d": np.array([m.los_d[0], m.los_d[1], -3.4]),
+                          "euler": np.array([m.euler[0], -3.3, 3.45]), "euler_d": np.array([m.euler_d[0], 3.3, -3.45])})
+    e1 = law.tracking_terms(law.paper_params(), m).e1
+    np.testing.assert_allclose(e1[[2, 4, 5]], [6.8 - 2 * math.pi, -6.6 + 2 * math.pi, 6.9 - 2 * math.pi], rtol=1e-12)
+
+
+@pytest.mark.parametrize("params", [law.paper_params(), law.paper_params(theorem=1), example_params()],
+                         ids=["paper", "theorem1", "example"])
+def test_the_float64_law_and_the_flight_units_golden_model_agree(params):
+    """On the unit's gate rows (inside and edges: random weights, commands, box edges) the float64 law and
+    the float32 golden model give the same status and, within float32 rounding, the same outputs and new
+    state (relative to the output limits and weight bounds)."""
+    unit = RbfUnit(params, 0.1)
+    bound = np.asarray(params.theta_max)
+    for name in ("inside", "edges"):
+        batch = unit.gate_classes(600, seed=3)[name]
+        out32, state32 = unit.golden(batch.state, batch.input)
+        for i in range(len(batch.input)):
+            s = batch.state[i]
+            state = law.RbfState(s["theta"].reshape(-1, 6).astype(float), s["theta_delta"].reshape(-1, 6).astype(float),
+                                 s["command"].astype(float))
+            out, new = law.step(params, state, from_record(batch.input[i:i + 1]), 0.1)
+            o = out32[i]
+            assert out.status == o["status"], (name, i, out.status, o["status"])
+            pairs = {"force": (out.force, o["force"], 1e-4 * params.force_max),
+                     "torque": (out.torque, o["torque"], 1e-4 * params.torque_max),
+                     "w_hat": (out.w_hat, o["w_hat"], 1e-5 * params.nodes * bound),
+                     "theta": (new.theta, state32[i]["theta"].reshape(-1, 6), 1e-5 * bound),
+                     "theta_delta": (new.theta_delta, state32[i]["theta_delta"].reshape(-1, 6), 1e-5 * bound),
+                     "command": (new.command, state32[i]["command"], 1e-4)}
+            for field, (ours, theirs, tol) in pairs.items():
+                worst = float(np.max(np.abs(ours - theirs) / tol))
+                assert worst <= 1.0, (name, i, field, worst)

@@ -12,6 +12,7 @@ from host.core.rotations import los_frame
 from host.gnc.los import measure
 from host.plant.proximity import MU_EARTH, ProximityPlant
 from host.sim import rbf_tracking as rt
+from host.errors import HostError
 
 DURATION = 80.0
 
@@ -85,7 +86,6 @@ def test_record_controller_flies_the_same_loop():
 @pytest.mark.parametrize("kwargs", [{"duration": -1.0}, {"duration": float("nan")}, {"duration": 10.0, "dt": 0.5},
                                     {"duration": 10.0, "dt": 0.0}])
 def test_bad_run_settings_are_one_line_host_errors(kwargs):
-    from host.errors import HostError
     with pytest.raises(HostError) as info:
         rt.simulate(paper_params(), **kwargs)
     assert "\n" not in str(info.value)

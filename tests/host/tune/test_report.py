@@ -192,6 +192,12 @@ def test_bad_rbf_inputs_are_one_line(tmp_path, capsys):
     assert main(["report", "--rbf", str(bad), "--out", str(tmp_path / "r")]) == 2
     err = capsys.readouterr().err
     assert "not written by `staregen simulate --controller rbf`" in err and "t_rho_5m" in err and err.count("\n") == 1
+    partial = {k: v for k, v in RBF_METRICS.items() if k != "max_rho_diff_m"}
+    (tmp_path / "partial").mkdir()
+    (tmp_path / "partial" / "metrics.json").write_text(json.dumps(partial))
+    assert main(["report", "--rbf", str(tmp_path / "partial"), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "max_rho_diff_m: missing" in err and err.count("\n") == 1 and "Traceback" not in err
     good = _rbf_run(tmp_path / "good")
     assert main(["report", "--rbf", str(good), "--tune", str(good), "--out", str(tmp_path / "r")]) == 2
     assert "--tune and --calibration need --evaluate" in capsys.readouterr().err

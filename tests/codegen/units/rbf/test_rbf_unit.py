@@ -8,16 +8,22 @@ caught, SPEC 6 golden, determinism — is tests/codegen/units/test_every_unit.py
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 import host.cli as cli
+from codegen.package.selftest import make_vectors, selftest_sources
 from codegen.unit import Batch
+from codegen.units.rbf import golden
 from codegen.units.rbf import records as rec
 from codegen.units.rbf.params import example_params, load_params, paper_params, params_from_mapping
 from codegen.units.rbf.unit import RbfUnit
+from firmware.flags import COMMON
+from tools.fuzz import fuzz
 from tools.gate import compare_fields
 from tools.runners import runner
 
@@ -341,7 +347,6 @@ def test_a_one_ulp_change_of_a_weight_changes_the_output():
     output or the state after) on nearly every row where the weight is not below its update (|theta_jk| >=
     |a z_k|; else the ulp can vanish in b theta_jk + phi_j a z_k, and in w_hat when phi_j ulp(theta_jk)
     is below half an ulp of the sum), and w_hat itself on most rows; golden and C alike."""
-    from codegen.units.rbf import golden
 
     unit = RbfUnit(PAPER)
     b = unit.gate_classes(6 * 300, seed=28)["inside"]
@@ -400,11 +405,7 @@ def test_the_unit_needs_its_parameters(capsys):
 def test_the_package_self_test_passes_and_clang_compiles_it(tmp_path):
     """The flight package's self-test (codegen.package.selftest) with the gate classes' vectors returns 0
     on x86; gcc and clang compile the unit with the flight flags (-Werror)."""
-    import shutil
-    import subprocess
 
-    from codegen.package.selftest import make_vectors, selftest_sources
-    from firmware.flags import COMMON
 
     unit = RbfUnit(PAPER, name="stare_rbf")
     files = {**unit.sources(), **selftest_sources("stare", [make_vectors(unit, 128, 0)])}
@@ -430,7 +431,6 @@ def test_the_package_self_test_passes_and_clang_compiles_it(tmp_path):
 def test_the_fuzzer_holds_the_weights_to_their_bounds():
     """tools/fuzz.py applies Unit.check_state to the golden states: random-bit states and inputs through
     the sanitizer build give no problem, and a planted state check is reported."""
-    from tools.fuzz import fuzz
 
     unit = RbfUnit(PAPER)
     assert fuzz(unit, 5_000, seed=3, log=lambda *_: None).ok
