@@ -1,9 +1,10 @@
 """Paper 004's closed loop (docs/gp-takeover.md sections 1, 3, 5): the combined body after capture,
 stabilised by a takeover law, and the data collection that feeds the GP.
 
-One control period: truth (host.plant.takeover) -> measured q, ω, h_w (perfect; the Table 6 error
-model is not wired in yet) -> controller -> wheels (torque and momentum limits) -> truth, RK4 at
-0.01 s with the wheel torque held over 0.1 s. A controller is any callable
+One control period: truth (host.plant.takeover) -> measured q, ω, h_w (perfect, or with an error model
+such as Table 6's: star sensor, gyro, wheel bias and noise) -> controller -> wheels (torque and
+momentum limits, then the wheel errors) -> truth, RK4 at 0.01 s with the wheel command held over
+0.1 s. A controller is any callable
 `(t, q, ω, h_w) -> LawOutput`; `law_controller` adapts the time-free laws of
 host.control.takeover_laws.
 
@@ -27,6 +28,7 @@ from host.control.takeover_laws import (
 )
 from host.core.constants import DEG
 from host.errors import HostError
+from host.plant.error_model import ErrorModel, draw_noise
 from host.plant.takeover import (
     DT,
     PERIOD,
@@ -35,6 +37,7 @@ from host.plant.takeover import (
     capture_state,
     error_quat,
     measured_unknown_term,
+    quat_compose,
 )
 from host.sim.rbf_tracking import time_to_stay_within
 
@@ -66,8 +69,11 @@ def error_angle(q) -> float:
 
 
 def simulate(controller: Controller, duration: float, plant: TakeoverPlant | None = None, x0=None,
-             period: float = PERIOD, dt: float = DT) -> dict[str, np.ndarray]:
-    """Closed loop for `duration` s from x0 (default: the capture state of section 1)."""
+             period: float = PERIOD, dt: float = DT, errors: ErrorModel | None = None,
+             seed: int = 0) -> dict[str, np.ndarray]:
+    """Closed loop for `duration` s from x0 (default: the capture state of section 1). With `errors`
+    (e.g. TABLE6_ERRORS) the controller sees measured q, ω and the wheels add their bias and noise;
+    `seed` picks the noise. Without, sensors and wheels are perfect."""
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise HostError(f"duration must be a positive number of seconds, got {duration!r}")
     if not (0 < dt <= period and math.isfinite(period)):
@@ -75,42 +81,74 @@ def simulate(controller: Controller, duration: float, plant: TakeoverPlant | Non
     plant = plant or TakeoverPlant()
     x = capture_state(plant) if x0 is None else np.array(x0, dtype=float)
     n = max(1, math.ceil(duration / period - 1e-9))
+    substeps = max(1, math.ceil(period / dt - 1e-9))
+    noise = draw_noise(errors, seed, 0, n + 1, period, substeps) if errors is not None else None
     h = _History(n + 1)
     for k in range(n + 1):
         t = k * period
-        q, w, hw = x[0:4], x[4:7], x[7:10]
-        h.state(k, t, x, plant)
+        q_m, w_m = measured_attitude(x, errors, noise, k)
+        h.state(k, t, x, q_m, w_m, plant)
         if k == n:
             break
-        out = controller(t, q.copy(), w.copy(), hw.copy())
-        u = plant.applied_torque(out.torque, hw)
-        h.command(k, out, u, plant, x)
-        x = plant.hold(x, u, period, dt)
+        out = controller(t, q_m, w_m, x[7:10].copy())
+        u = plant.applied_torque(out.torque, x[7:10])
+        u_steps = wheel_torques(u, errors, noise, k, substeps)
+        h.command(k, out, u, u_steps, plant, x)
+        for u_j in u_steps:
+            x = plant.rk4_step(x, u_j, period / substeps)
     hist = h.arrays()
     hist["period"] = np.float64(period)
     return hist
+
+
+def small_rotation_quat(e) -> np.ndarray:
+    """The quaternion of a small body-axis rotation vector e (rad), normalised."""
+    q = np.concatenate([0.5 * np.asarray(e, float), [1.0]])
+    return q / np.sqrt(q @ q)
+
+
+def measured_attitude(x, errors: ErrorModel | None, noise, k: int):
+    """Star sensor and gyro at control instant k: (bias + noise) as a small body-axis rotation on q (our
+    reading of Table 6's per-angle error for a quaternion output) and as an additive error on ω."""
+    q, w = x[0:4].copy(), x[4:7].copy()
+    if errors is None:
+        return q, w
+    q_m = quat_compose(small_rotation_quat(errors.star.bias_array + noise.star[k]), q)
+    return q_m, (w + errors.gyro.bias_array) + noise.gyro[k]
+
+
+def wheel_torques(u, errors: ErrorModel | None, noise, k: int, substeps: int) -> list[np.ndarray]:
+    """The torque the wheels put on the body at each plant step of period k: (u + bias) + noise."""
+    if errors is None:
+        return [u] * substeps
+    rows = noise.wheels[k * substeps:(k + 1) * substeps]
+    return [(u + errors.wheels.bias_array) + r for r in rows]
 
 
 class _History:
     def __init__(self, n: int):
         nan3 = lambda: np.full((n, 3), np.nan)   # noqa: E731
         self.t, self.angle = np.empty(n), np.empty(n)
-        self.q = np.empty((n, 4))
+        self.q, self.q_meas = np.empty((n, 4)), np.empty((n, 4))
+        self.omega_meas = np.empty((n, 3))
+        self.torque_known = nan3()                # the command after the limits: what the servicer knows it asked
         self.omega, self.h_w, self.counter_torque = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3))
         self.torque, self.torque_applied = nan3(), nan3()
         self.mu, self.var = nan3(), nan3()
         self.gains = np.full((n, 2), np.nan)
         self.omega_dot, self.d_true = nan3(), nan3()
 
-    def state(self, k, t, x, plant):
+    def state(self, k, t, x, q_m, w_m, plant):
         self.t[k], self.q[k], self.omega[k], self.h_w[k] = t, x[0:4], x[4:7], x[7:10]
+        self.q_meas[k], self.omega_meas[k] = q_m, w_m
         self.angle[k] = error_angle(x[0:4])
         self.counter_torque[k] = plant.counter_torque(x)
 
-    def command(self, k, out, u, plant, x):
-        self.torque[k], self.torque_applied[k] = out.torque, u
+    def command(self, k, out, u, u_steps, plant, x):
+        self.torque[k], self.torque_known[k] = out.torque, u
+        self.torque_applied[k] = np.mean(u_steps, axis=0)          # exact mean over the period (ZOH per step)
         self.mu[k], self.var[k], self.gains[k] = out.mu, out.var, out.gains
-        wdot = plant.derivative(x, u)[4:7]         # truth ω̇ at the start of the period
+        wdot = plant.derivative(x, u_steps[0])[4:7]         # truth ω̇ at the start of the period
         self.omega_dot[k], self.d_true[k] = wdot, plant.unknown_term(x, wdot)
 
     def arrays(self) -> dict[str, np.ndarray]:
@@ -207,12 +245,12 @@ def samples_of(hist: dict[str, np.ndarray], prior_inertia, sample_rate: float = 
     ks = np.arange(step, n_ctrl - half + 1, step)         # t = 1 .. 299 s for 300 s at 1 Hz
     rows = {key: [] for key in ("t", "x", "d", "u", "h_w", "omega_dot_true", "d_true")}
     for k in ks:
-        omega_dot = (hist["omega"][k + half] - hist["omega"][k - half]) / (2 * half * T)
-        omega = _trapezoid_mean(hist["omega"][k - half:k + half + 1])
+        omega_dot = (hist["omega_meas"][k + half] - hist["omega_meas"][k - half]) / (2 * half * T)
+        omega = _trapezoid_mean(hist["omega_meas"][k - half:k + half + 1])
         h_w = _trapezoid_mean(hist["h_w"][k - half:k + half + 1])
-        u = np.mean(hist["torque_applied"][k - half:k + half], axis=0)
+        u = np.mean(hist["torque_known"][k - half:k + half], axis=0)
         rows["t"].append(hist["t"][k])
-        rows["x"].append(np.concatenate([attitude_error(hist["q"][k]), omega, omega_dot]))
+        rows["x"].append(np.concatenate([attitude_error(hist["q_meas"][k]), omega, omega_dot]))
         rows["d"].append(measured_unknown_term(prior_inertia, omega, omega_dot, h_w, u))
         rows["u"].append(u)
         rows["h_w"].append(h_w)
@@ -221,9 +259,12 @@ def samples_of(hist: dict[str, np.ndarray], prior_inertia, sample_rate: float = 
     return {key: np.array(v) for key, v in rows.items()}
 
 
-def collect(seeds, duration: float = RUN_DURATION, plant: TakeoverPlant | None = None) -> dict[str, np.ndarray]:
+def collect(seeds, duration: float = RUN_DURATION, plant: TakeoverPlant | None = None,
+            errors: ErrorModel | None = None) -> dict[str, np.ndarray]:
     """Section 3's data: one excited run per seed from the capture attitude; the samples of all runs
-    stacked (x N×9, d N×3, u, h_w, t, seed, and the truth's ω̇ and d at the sample instants)."""
+    stacked (x N×9, d N×3, u, h_w, t, seed, and the truth's ω̇ and d at the sample instants). With
+    `errors` the samples come from the measured q and ω and the wheels' errors act on the truth (the
+    run's seed also picks the noise)."""
     seeds = list(seeds)
     if not seeds or not all(isinstance(s, (int, np.integer)) and s >= 0 for s in seeds):
         raise HostError(f"seeds must be a non-empty list of non-negative integers, got {seeds!r}")
@@ -232,7 +273,7 @@ def collect(seeds, duration: float = RUN_DURATION, plant: TakeoverPlant | None =
     for seed in seeds:
         exc = Excitation(int(seed), duration, prior_inertia=plant.prior_inertia)
         x0 = capture_state(plant, omega0=exc.initial_rate)
-        part = samples_of(simulate(exc, duration, plant, x0), plant.prior_inertia)
+        part = samples_of(simulate(exc, duration, plant, x0, errors=errors, seed=int(seed)), plant.prior_inertia)
         part["seed"] = np.full(len(part["t"]), int(seed))
         parts.append(part)
     return {key: np.concatenate([p[key] for p in parts]) for key in parts[0]}
