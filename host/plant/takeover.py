@@ -144,8 +144,8 @@ class TakeoverPlant:
         return momentum_limited_torque(u, np.asarray(h_w, dtype=float), self.momentum_limit)
 
     def hold(self, x, u, period: float = PERIOD, dt: float = DT) -> np.ndarray:
-        """Propagate one control period with the applied wheel torque u held (n equal RK4 steps ≤ dt).
-        The momentum limit is checked at the start of the period only."""
+        """Propagate one control period with the applied wheel torque u held (n equal RK4 steps ≤ dt);
+        `applied_torque` is the caller's, once per period (the momentum limit acts at control instants)."""
         n = max(1, math.ceil(period / dt - 1e-9))
         h = period / n
         for _ in range(n):

@@ -23,7 +23,6 @@ from host.control.takeover_laws import (
     Gains,
     LawOutput,
     attitude_error,
-    gp_input,
     pd_torque,
 )
 from host.core.constants import DEG
@@ -280,4 +279,4 @@ def collect(seeds, duration: float = RUN_DURATION, plant: TakeoverPlant | None =
 
 
 __all__ = ["Controller", "law_controller", "simulate", "metrics_of", "momentum_limit_time", "collect",
-           "samples_of", "Excitation", "error_angle", "gp_input"]
+           "samples_of", "Excitation", "error_angle", "measured_attitude", "wheel_torques"]

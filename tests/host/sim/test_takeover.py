@@ -213,3 +213,12 @@ def test_collect_with_errors_learns_the_wheel_bias_into_d():
     assert data["x"].shape == (29, 9)
     offset = np.mean(data["d_true"] - data["d"], axis=0)
     np.testing.assert_allclose(offset, -0.01, atol=0.005)
+
+
+def test_momentum_limit_time_of_a_linear_ramp():
+    t = np.arange(0.0, 301.0)
+    h = np.stack([10.0 + 0.05 * t, -5.0 - 0.1 * t, 3.5 - 0.01 * t], axis=1)   # z shrinking towards 0 (0.5 at the end)
+    out = st.momentum_limit_time(t, h, 50.0)
+    assert out[0] == pytest.approx(300.0 + (50.0 - 25.0) / 0.05)
+    assert out[1] == pytest.approx(300.0 + (50.0 - 35.0) / 0.1)
+    assert out[2] is None
