@@ -154,3 +154,9 @@ def test_construction_validates():
         make(m=np.zeros((3, M + 1)))
     with pytest.raises(ArtifactError, match="payload.variational.R.0.: diagonal"):
         make(R=np.zeros((3, M, M)))
+
+
+def test_gp_folder_registers_no_unit_yet():
+    import codegen.units as units
+    known = units.kinds()
+    assert "gp" not in known and "rbf" in known
