@@ -209,15 +209,13 @@ def train_sparse(x, d, m: int = DEFAULT_M, iterations: int = SPARSE_ITERATIONS, 
         torch.manual_seed(seed)
         t0 = time.perf_counter()
         model = _sparse_model_class()(torch.as_tensor(Z0, dtype=torch.float64)).double()
-        likelihood = gpytorch.likelihoods.MultitaskGaussianLikelihood(num_tasks=3, rank=0).double()
+        likelihood = gpytorch.likelihoods.MultitaskGaussianLikelihood(   # per-axis noise only (§2)
+            num_tasks=3, rank=0, has_global_noise=False).double()
         _init_kernel(model.covar_module)
         likelihood.task_noises = torch.full((3,), INIT_NOISE, dtype=torch.float64)
-        likelihood.noise = torch.full((1,), 1e-4, dtype=torch.float64)   # the shared noise term at its floor
-        likelihood.raw_noise.requires_grad_(False)                        # per-axis noise only (§2)
         model.train()
         likelihood.train()
-        opt = torch.optim.Adam([{"params": model.parameters()},
-                                {"params": [likelihood.raw_task_noises]}], lr=lr)
+        opt = torch.optim.Adam([{"params": model.parameters()}, {"params": likelihood.parameters()}], lr=lr)
         elbo = gpytorch.mlls.VariationalELBO(likelihood, model, num_data=len(x))
         for _ in range(iterations):
             opt.zero_grad()
@@ -249,7 +247,7 @@ def flight_arrays(fit: GpFit) -> gpa.GpArrays:
         output_scale=np.asarray(fit.output_scale, dtype=np.float64).copy(),
         lengthscale=model.covar_module.base_kernel.lengthscale.detach().numpy().reshape(9).astype(np.float64),
         outputscale=float(model.covar_module.outputscale.detach()),
-        noise=(task_noise + float(fit.likelihood.noise.detach())).astype(np.float64),
+        noise=task_noise.astype(np.float64),
         jitter=float(jitter),
         Z=base.inducing_points.detach().numpy().astype(np.float64).copy(),
         m=vd.variational_mean.detach().numpy().astype(np.float64).copy(),

@@ -3,6 +3,7 @@ and the sparse GP on nested training sets (the first N of the pool), growth rati
 smallest N. Times follow §4 (construction + optimisation loop, one torch thread); MSE per §3.
 
     python -m host.learn.gp_table1 --synthetic [--sizes 500,1000,1500,2000] [--m 20]
+                                   [--exact-iterations 200] [--sparse-iterations 1000]
 """
 from __future__ import annotations
 
@@ -61,6 +62,9 @@ def main(argv=None) -> int:
     p.add_argument("--sizes", default="500,1000,1500,2000")
     p.add_argument("--m", type=int, default=gp.DEFAULT_M)
     p.add_argument("--repeats", type=int, default=1)
+    p.add_argument("--exact-iterations", type=int, default=gp.EXACT_ITERATIONS,
+                   help="fewer than §4's 200 for a quick per-iteration growth measurement")
+    p.add_argument("--sparse-iterations", type=int, default=gp.SPARSE_ITERATIONS)
     args = p.parse_args(argv)
     sizes = tuple(int(s) for s in args.sizes.split(","))
     x_pool, d_pool = gp.synthetic(max(sizes), seed=0)
@@ -69,7 +73,8 @@ def main(argv=None) -> int:
     import torch
     print(json.dumps({"cpu": platform.processor() or platform.machine(), "torch": torch.__version__,
                       "gpytorch": gpytorch.__version__, "threads": 1}), flush=True)
-    rows = table1(x_pool, d_pool, x_test, d_test, sizes, args.m, repeats=args.repeats,
+    rows = table1(x_pool, d_pool, x_test, d_test, sizes, args.m, exact_iterations=args.exact_iterations,
+                  sparse_iterations=args.sparse_iterations, repeats=args.repeats,
                   log=lambda s: print(s, flush=True))
     for row in rows:
         print(json.dumps(row), flush=True)
