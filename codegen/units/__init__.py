@@ -1,7 +1,8 @@
 """The registry of generated units: one folder per unit below this package.
 
 A unit folder's `__init__.py` defines `KIND` (a codegen.unit.UnitKind); `kinds()` imports every
-folder here and collects them, so adding a unit is adding its folder. A unit that lives
+folder here and collects them, so adding a unit is adding its folder. A folder without `KIND` is a
+unit under construction (e.g. `gp`, whose artifact exists before its unit) and is not registered. A unit that lives
 elsewhere (a user's own, or a test's throw-away one) calls `register(kind)` once.
 """
 from __future__ import annotations
@@ -39,7 +40,8 @@ def _discover() -> None:
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         if info.ispkg:
             module = importlib.import_module(f"{__name__}.{info.name}")
-            register(getattr(module, "KIND"))
+            if hasattr(module, "KIND"):
+                register(module.KIND)
     _discovered = True
 
 
