@@ -1,8 +1,9 @@
 """The registry of generated units: one folder per unit below this package.
 
 A unit folder's `__init__.py` defines `KIND` (a codegen.unit.UnitKind); `kinds()` imports every
-folder here and collects them, so adding a unit is adding its folder. A folder without `KIND` is a
-unit under construction (e.g. `gp`, whose artifact exists before its unit) and is not registered. A unit that lives
+folder here and collects them, so adding a unit is adding its folder. A folder under construction
+says so with `KIND = None` (e.g. `gp`, whose artifact exists before its unit) and is not registered;
+a folder without `KIND` is an error, not a silently missing unit. A unit that lives
 elsewhere (a user's own, or a test's throw-away one) calls `register(kind)` once.
 """
 from __future__ import annotations
@@ -40,7 +41,10 @@ def _discover() -> None:
     for info in sorted(pkgutil.iter_modules(__path__), key=lambda m: m.name):
         if info.ispkg:
             module = importlib.import_module(f"{__name__}.{info.name}")
-            if hasattr(module, "KIND"):
+            if not hasattr(module, "KIND"):
+                raise CodegenError(f"codegen/units/{info.name}: defines no KIND (a UnitKind, or None while "
+                                   "the unit is under construction)")
+            if module.KIND is not None:
                 register(module.KIND)
     _discovered = True
 

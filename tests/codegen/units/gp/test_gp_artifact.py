@@ -11,7 +11,9 @@ import math
 import numpy as np
 import pytest
 
+from codegen import units
 from codegen.artifact import ArtifactError, hex_float, payload_sha256
+from codegen.errors import CodegenError
 from codegen.units.gp import artifact as gpa
 
 M = 6
@@ -157,6 +159,16 @@ def test_construction_validates():
 
 
 def test_gp_folder_registers_no_unit_yet():
-    import codegen.units as units
     known = units.kinds()
     assert "gp" not in known and "rbf" in known
+
+
+def test_a_unit_folder_without_kind_is_an_error(tmp_path, monkeypatch):
+    """A folder that forgets KIND must not vanish from the registry silently."""
+    (tmp_path / "nokind").mkdir()
+    (tmp_path / "nokind" / "__init__.py").write_text('"""A unit folder that forgot its KIND."""\n')
+    monkeypatch.setattr(units, "__path__", [*units.__path__, str(tmp_path)])
+    monkeypatch.setattr(units, "_discovered", False)
+    monkeypatch.setattr(units, "_registered", {})
+    with pytest.raises(CodegenError, match="codegen/units/nokind: defines no KIND"):
+        units.kinds()
