@@ -42,6 +42,7 @@ COMMANDS = [
     "host.cli.report",
     "host.cli.tanh",
     "host.cli.dp",
+    "host.cli.gp",
 ]
 
 

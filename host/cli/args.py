@@ -27,6 +27,14 @@ def parse_int(text: str, what: str, minimum: int = 0, maximum: int | None = None
     return value
 
 
+def parse_list(text: str, what: str, parse) -> tuple:
+    """A comma-separated list, each item through `parse(item)`; at least one item."""
+    parts = [p.strip() for p in text.split(",") if p.strip()]
+    if not parts:
+        raise HostError(f"{what} needs at least one value")
+    return tuple(parse(p) for p in parts)
+
+
 def parse_number(text: str, what: str, *, positive: bool = False, non_negative: bool = False,
                  minimum: float | None = None, maximum: float | None = None) -> float:
     """A real in ASCII digits (codegen.number_text) within bounds."""

@@ -14,7 +14,7 @@ from tqdm import tqdm
 
 from codegen import atomic
 from codegen.units.dp import tables as dp_tables
-from host.cli.args import parse_int, parse_number
+from host.cli.args import parse_int, parse_list, parse_number
 from codegen.units.dp.params import DpParams
 from host.control.nn_controller import load_artifact
 from host.errors import HostError
@@ -52,16 +52,9 @@ def register(subparsers) -> None:
     b.set_defaults(func=build_main)
 
 
-def _list(text: str, what: str, parse) -> tuple:
-    parts = [p for p in text.split(",") if p.strip()]
-    if not parts:
-        raise HostError(f"{what} needs at least one value")
-    return tuple(parse(p.strip()) for p in parts)
-
-
 def accuracy_main(args) -> int:
-    rs = _list(args.r, "--r", lambda p: parse_number(p, "--r", positive=True))
-    s_limits = _list(args.s_limit, "--s-limit", lambda p: parse_int(p, "--s-limit", 1))
+    rs = parse_list(args.r, "--r", lambda p: parse_number(p, "--r", positive=True))
+    s_limits = parse_list(args.s_limit, "--s-limit", lambda p: parse_int(p, "--s-limit", 1))
     base = DpParams(n_min=parse_int(args.n_min, "--n-min", 1), widen=parse_number(args.widen, "--widen"),
                     s_limit=max(s_limits))
     for r in rs:
