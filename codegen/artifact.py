@@ -288,7 +288,7 @@ class Artifact:
         return sealed(FORMAT, VERSION, self.payload())
 
     def to_json(self) -> str:
-        return _pretty_json(self.document()) + "\n"
+        return pretty_json(self.document()) + "\n"
 
     def save(self, path: str | os.PathLike) -> Path:
         """Write atomically (a killed run leaves the old file or the new one)."""
@@ -336,16 +336,16 @@ def _payload_of(a: Artifact) -> dict:
     }
 
 
-def _pretty_json(obj, indent: int = 0) -> str:
+def pretty_json(obj, indent: int = 0) -> str:
     """JSON with one line per innermost list of scalars (a weight row stays on one line)."""
     pad, inner = " " * indent, " " * (indent + 2)
     if isinstance(obj, dict):
         if not obj:
             return "{}"
-        items = [f"{inner}{json.dumps(k)}: {_pretty_json(v, indent + 2)}" for k, v in obj.items()]
+        items = [f"{inner}{json.dumps(k)}: {pretty_json(v, indent + 2)}" for k, v in obj.items()]
         return "{\n" + ",\n".join(items) + "\n" + pad + "}"
     if isinstance(obj, list) and any(isinstance(v, (list, dict)) for v in obj):
-        items = [f"{inner}{_pretty_json(v, indent + 2)}" for v in obj]
+        items = [f"{inner}{pretty_json(v, indent + 2)}" for v in obj]
         return "[\n" + ",\n".join(items) + "\n" + pad + "]"
     return json.dumps(obj, allow_nan=False)
 
@@ -634,8 +634,8 @@ def random_artifact(shape: Sequence[int] = (12, 40, 3), seed: int = 0) -> Artifa
 
 # ----------------------------------------------------------------------------- loader
 
-class _Reader:
-    """Walks the JSON document; every complaint names the field path."""
+class DocumentReader:
+    """Walks a sealed JSON document (the network artifact, the GP artifact); every complaint names the field path."""
 
     def __init__(self, source: str | None):
         self.source = source
@@ -704,7 +704,7 @@ def _json_type(value) -> str:
             int: "a number", float: "a number", type(None): "null"}.get(type(value), type(value).__name__)
 
 
-def _read_sizes(r: _Reader, network: dict) -> tuple[int, int, int]:
+def _read_sizes(r: DocumentReader, network: dict) -> tuple[int, int, int]:
     sizes = r.list(network["sizes"], f"{NETWORK}.sizes")
     if len(sizes) != 3:
         r.fail(f"{NETWORK}.sizes", f"expected 3 sizes [n_in, n_hidden, n_out], got {len(sizes)}")
@@ -720,14 +720,14 @@ def _read_sizes(r: _Reader, network: dict) -> tuple[int, int, int]:
     return tuple(sizes)  # type: ignore[return-value]
 
 
-def _read_layer(r: _Reader, value, k: int, rows: int, cols: int, meaning: str) -> tuple[np.ndarray, np.ndarray]:
+def _read_layer(r: DocumentReader, value, k: int, rows: int, cols: int, meaning: str) -> tuple[np.ndarray, np.ndarray]:
     path = f"{NETWORK}.layers[{k}]"
     layer = r.obj(value, path, ("weights", "bias"))
     return (r.matrix(layer["weights"], f"{path}.weights", rows, cols, meaning),
             r.vector(layer["bias"], f"{path}.bias", rows))
 
 
-def _read_map(r: _Reader, value, path: str, n: int) -> MapMinMax:
+def _read_map(r: DocumentReader, value, path: str, n: int) -> MapMinMax:
     m = r.obj(value, path, ("xmin", "xmax", "ymin", "ymax", "xoffset", "gain"))
     return MapMinMax(
         xmin=r.vector(m["xmin"], f"{path}.xmin", n, float32=False),
@@ -739,7 +739,7 @@ def _read_map(r: _Reader, value, path: str, n: int) -> MapMinMax:
     )
 
 
-def _read_envelope(r: _Reader, value, n_in: int) -> Envelope:
+def _read_envelope(r: DocumentReader, value, n_in: int) -> Envelope:
     e = r.obj(value, ENVELOPE, ("source", "names", "units", "descriptions", "min", "max"))
     if not isinstance(e["source"], str):
         r.fail(f"{ENVELOPE}.source", f"expected a string, got {_json_type(e['source'])}")
@@ -752,14 +752,14 @@ def _read_envelope(r: _Reader, value, n_in: int) -> Envelope:
     )
 
 
-def _read_outputs(r: _Reader, value, n_out: int) -> OutputSpec:
+def _read_outputs(r: DocumentReader, value, n_out: int) -> OutputSpec:
     o = r.obj(value, "payload.outputs", ("names", "units", "descriptions"))
     return OutputSpec(*(r.strings(o[k], f"payload.outputs.{k}", n_out) for k in ("names", "units", "descriptions")))
 
 
 def from_document(doc: Any, source: str | None = None) -> Artifact:
     """Validate a parsed JSON document and build the Artifact; the sha256 seal is checked last."""
-    r = _Reader(source)
+    r = DocumentReader(source)
     r.obj(doc, "", ("format", "version", "sha256", "payload"))
     if doc["format"] != FORMAT:
         r.fail("format", f"expected {FORMAT!r}, got {doc['format']!r}")
@@ -784,7 +784,7 @@ def from_document(doc: Any, source: str | None = None) -> Artifact:
         )
     except ArtifactError as exc:
         raise ArtifactError(exc.field_path, exc.reason, source) from None
-    _check_seal(r, doc)
+    check_seal(r, doc)
     if artifact.sha256 != doc["sha256"]:   # every value canonical, so this holds unless a rule is missing
         r.fail("payload", "not in canonical form: its values re-serialise to another text than the sealed one")
     return artifact
@@ -807,7 +807,7 @@ def seal_problem(doc: dict) -> str | None:
     return None
 
 
-def _check_seal(r: _Reader, doc: dict) -> None:
+def check_seal(r: DocumentReader, doc: dict) -> None:
     problem = seal_problem(doc)
     if problem:
         r.fail("sha256", problem)

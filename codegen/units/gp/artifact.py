@@ -197,7 +197,7 @@ class GpArtifact:
         return art.sealed(FORMAT, VERSION, self.payload())
 
     def to_json(self) -> str:
-        return art._pretty_json(self.document()) + "\n"
+        return art.pretty_json(self.document()) + "\n"
 
     def save(self, path: str | os.PathLike) -> Path:
         path = Path(path)
@@ -310,7 +310,7 @@ def validate(g: GpArtifact) -> None:
 
 # ----------------------------------------------------------------------------- loader
 
-_R = art._Reader
+_R = art.DocumentReader
 
 
 def _real_list(r, value, path: str, n: int, float32: bool) -> np.ndarray:
@@ -417,7 +417,7 @@ def from_document(doc: Any, source: str | None = None) -> GpArtifact:
         if not _ulp_close(value, derived[name]):
             r.fail(f"payload.flight.{name}", "differs by more than 1 float32 ulp from its re-derivation from "
                                              "the float64 fields")
-    art._check_seal(r, doc)
+    art.check_seal(r, doc)
     return g
 
 
