@@ -15,9 +15,12 @@ from __future__ import annotations
 
 import math
 import re
+import tomllib
+from pathlib import Path
 
 import numpy as np
 
+from codegen import reading
 from codegen.errors import CodegenError
 
 FLOAT32_MAX = float(np.finfo(np.float32).max)
@@ -143,3 +146,24 @@ def toml_number_problem(text: str) -> str | None:
             line = text.count("\n", 0, m.start()) + 1
             return f"line {line}: number {word[:40]!r}: write plain decimal digits (no '_', no 0x/0o/0b)"
     return None
+
+
+def read_parameter_file(path: str | Path, error: type[CodegenError] = CodegenError) -> dict:
+    """The parsed mapping of a unit's .toml or .json parameter file: a regular file, read capped,
+    strict JSON or TOML without TOML's own number extensions; every problem one line naming the file."""
+    path = Path(path)
+    if path.suffix not in (".toml", ".json"):
+        raise error(f"{path}: parameter file must end in .toml or .json")
+    try:
+        text = reading.read_text(path)
+    except reading.InputFileError as exc:
+        raise error(str(exc)) from None
+    try:
+        data = tomllib.loads(text) if path.suffix == ".toml" else reading.parse_json(text)
+    except (ValueError, RecursionError) as exc:   # syntax, duplicate keys, NaN, integers of > 4300 digits
+        first_line = str(exc).splitlines()[0] if str(exc) else "nested too deeply"
+        raise error(f"{path}: not valid {path.suffix[1:].upper()}: {first_line}") from None
+    problem = toml_number_problem(text) if path.suffix == ".toml" else None
+    if problem:
+        raise error(f"{path}: {problem}")
+    return data

@@ -10,13 +10,12 @@ input is e = [x1; x2] (12 values) scaled by 1/input_scale.
 """
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
-from codegen import reading, values
+from codegen import values
 from codegen.errors import CodegenError
 
 NODES_MIN, NODES_MAX = 2, 15      # 15 nodes: 90 weights per network, well inside the 64 KB CCM
@@ -170,20 +169,7 @@ def params_from_mapping(data: dict) -> RbfParams:
 def load_params(path: str | Path) -> RbfParams:
     """Read a .toml or .json parameter file (flat keys, see RbfParams) and validate it."""
     path = Path(path)
-    if path.suffix not in (".toml", ".json"):
-        raise RbfParamsError(f"{path}: parameter file must end in .toml or .json")
-    try:
-        text = reading.read_text(path)
-    except reading.InputFileError as exc:
-        raise RbfParamsError(str(exc)) from None
-    try:
-        data = tomllib.loads(text) if path.suffix == ".toml" else reading.parse_json(text)
-    except (ValueError, RecursionError) as exc:   # syntax, duplicate keys, NaN, integers of > 4300 digits
-        first_line = str(exc).splitlines()[0] if str(exc) else "nested too deeply"
-        raise RbfParamsError(f"{path}: not valid {path.suffix[1:].upper()}: {first_line}") from None
-    problem = values.toml_number_problem(text) if path.suffix == ".toml" else None
-    if problem:
-        raise RbfParamsError(f"{path}: {problem}")
+    data = values.read_parameter_file(path, RbfParamsError)
     try:
         return params_from_mapping(data)
     except RbfParamsError as exc:

@@ -6,13 +6,12 @@ CodegenError, so the CLI prints them as one line).
 """
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from codegen import reading, values
+from codegen import values
 from codegen.errors import CodegenError
 
 
@@ -152,20 +151,7 @@ def params_from_mapping(data: dict) -> TanhParams:
 def load_params(path: str | Path) -> TanhParams:
     """Read a .toml or .json parameter file (flat keys, see TanhParams) and validate it."""
     path = Path(path)
-    if path.suffix not in (".toml", ".json"):
-        raise TanhParamsError(f"{path}: parameter file must end in .toml or .json")
-    try:
-        text = reading.read_text(path)
-    except reading.InputFileError as exc:
-        raise TanhParamsError(str(exc)) from None
-    try:
-        data = tomllib.loads(text) if path.suffix == ".toml" else reading.parse_json(text)
-    except (ValueError, RecursionError) as exc:   # syntax, duplicate keys, NaN, integers of > 4300 digits
-        first_line = str(exc).splitlines()[0] if str(exc) else "nested too deeply"
-        raise TanhParamsError(f"{path}: not valid {path.suffix[1:].upper()}: {first_line}") from None
-    problem = values.toml_number_problem(text) if path.suffix == ".toml" else None
-    if problem:
-        raise TanhParamsError(f"{path}: {problem}")
+    data = values.read_parameter_file(path, TanhParamsError)
     try:
         return params_from_mapping(data)
     except TanhParamsError as exc:
