@@ -158,9 +158,15 @@ def test_construction_validates():
         make(R=np.zeros((3, M, M)))
 
 
-def test_gp_folder_registers_no_unit_yet():
+def test_a_unit_folder_under_construction_is_skipped(tmp_path, monkeypatch):
+    """`KIND = None` keeps a folder out of the registry (a unit whose artifact exists before its C)."""
+    (tmp_path / "wip").mkdir()
+    (tmp_path / "wip" / "__init__.py").write_text('"""Under construction."""\nKIND = None\n')
+    monkeypatch.setattr(units, "__path__", [*units.__path__, str(tmp_path)])
+    monkeypatch.setattr(units, "_discovered", False)
+    monkeypatch.setattr(units, "_registered", {})
     known = units.kinds()
-    assert "gp" not in known and "rbf" in known
+    assert "wip" not in known and {"gp", "rbf"} <= set(known)
 
 
 def test_a_unit_folder_without_kind_is_an_error(tmp_path, monkeypatch):
