@@ -77,6 +77,7 @@ UNREACHABLE = {
                    "status |= CONTROLLER_STATUS_PID | status == 0u ? CONTROLLER_STATUS_DWELL : 0u;",
                    "} else if ib < CONTROLLER_NN_TANH_HALF {", "y[0] = s0 != s0 ? nan.f : s0;",
                    "y[1] = s1 != s1 ? nan.f : s1;", "y[2] = s2 != s2 ? nan.f : s2;"),
+    "gp": ("k1 = k1 <= GP_K1_BAR ? k1 : GP_K1_BAR;", "k2 = k2 <= GP_K2_BAR ? k2 : GP_K2_BAR;"),
     "network": (),
     "rbf": ("return acc <= RBF_RESULT_MAX ? 1u : 0u;",),
     "tanh": (),

@@ -77,7 +77,7 @@ def test_a_loop_without_annotation_is_an_error(tmp_path):
 RANDOM_RECORDS = 10_000
 
 
-@pytest.mark.parametrize("kind", ["network", "controller", "tanh", "rbf"])
+@pytest.mark.parametrize("kind", ["network", "controller", "tanh", "rbf", "gp"])
 def test_bound_covers_every_sampled_count_on_random_bits(kind):
     """>= 10,000 records of random bits (NaN, Inf, subnormal, huge, random state) under the profiler:
     no evaluation may exceed the static bound, in either table or memory mode."""
@@ -96,7 +96,7 @@ def test_bound_covers_every_sampled_count_on_random_bits(kind):
 
 # ----------------------------------------------------------------- tightness (SPEC 8 uses both)
 
-@pytest.mark.parametrize("kind", ["network", "controller", "rbf"])
+@pytest.mark.parametrize("kind", ["network", "controller", "rbf", "gp"])
 def test_bound_is_within_15_percent_of_the_sampled_max(kind):
     """The network path and the whole step: the static bound is at most 15 % above the largest
     count over the unit's own cycle classes (ideal, strict), so the bound is a figure to sign,

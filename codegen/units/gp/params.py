@@ -94,6 +94,12 @@ def validate(p: GpLawParams) -> None:
         _fail("inertia", "must be positive definite")
 
 
+def _checked(value, key: str, low=None, high=None) -> float:
+    """The file's float64 value once its float32 rounding passes the range check (the C rounds it)."""
+    values.float32_in(value, key, low, high, error=GpParamsError)
+    return float(value)
+
+
 def inertia_matrix(inertia) -> np.ndarray:
     """The 3x3 inertia of a file's nested list, each entry checked (|J_ij| <= 1e6, normal float32 or 0)."""
     if not isinstance(inertia, (list, tuple)) or len(inertia) != 3:
@@ -102,8 +108,7 @@ def inertia_matrix(inertia) -> np.ndarray:
     for i, row in enumerate(inertia):
         if not isinstance(row, (list, tuple)) or len(row) != 3:
             _fail(f"inertia[{i}]", f"must be a row of 3 numbers, got {values.show(row)}")
-        rows.append([float(values.float32_in(v, f"inertia[{i}][{j}]", -INERTIA_MAX, INERTIA_MAX, error=GpParamsError))
-                     for j, v in enumerate(row)])
+        rows.append([_checked(v, f"inertia[{i}][{j}]", -INERTIA_MAX, INERTIA_MAX) for j, v in enumerate(row)])
     return np.array(rows)
 
 
@@ -134,7 +139,7 @@ def load_params(path) -> GpLawParams:
             gp = gpa.load(artifact_path)
         except ArtifactError as exc:
             raise GpParamsError(f"artifact: {exc}") from None
-        scalars = {k: float(values.float32_in(data[k], k, error=GpParamsError)) for k in _SCALAR_KEYS}
+        scalars = {k: _checked(data[k], k) for k in _SCALAR_KEYS}
         inertia = tuple(tuple(r) for r in inertia_matrix(data["inertia"]).tolist())
         return GpLawParams(gp=gp, inertia=inertia, artifact_name=data["artifact"], **scalars)
     except GpParamsError as exc:
