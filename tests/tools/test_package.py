@@ -11,6 +11,7 @@ import pytest
 
 from codegen.artifact import random_artifact
 from codegen.package import manifest
+from codegen.units.gp.example import example_params as gp_example_params
 from codegen.units.rbf.params import example_params as rbf_example_params
 from codegen.units.tanh.params import example_params
 from firmware.errors import FirmwareError
@@ -153,3 +154,16 @@ def test_package_with_the_tanh_and_rbf_laws(tmp_path):
     assert result.manifest["evidence"]["package_build"]["x86"]["selftest_mismatches"] == 0
     icd = (result.folder / "ICD.md").read_text()
     assert "## Unit `rbf`: `stare_rbf`" in icd and "`stare_rbf_state_t`" in icd
+
+
+def test_package_with_the_gp_law(tmp_path):
+    """The stateless GP law joins a package the same way; its ICD states its fields and status bits."""
+    cfg = default_package_config()
+    cfg = type(cfg)(cfg.name, ("controller", "gp"), cfg.controller)
+    result = generate(tmp_path / "gp", cfg, {"gp": gp_example_params()})
+    for name in ("src/stare_gp.c", "include/stare_gp.h"):
+        assert name in result.manifest["files"]
+    assert result.manifest["evidence"]["package_build"]["arm"]["selftest_mismatches"] == 0
+    assert result.manifest["evidence"]["package_build"]["x86"]["selftest_mismatches"] == 0
+    icd = (result.folder / "ICD.md").read_text()
+    assert "## Unit `gp`: `stare_gp`" in icd and "STATUS_VAR_FLOOR" in icd and "(N*m)^2" in icd
