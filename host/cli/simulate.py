@@ -173,8 +173,9 @@ def _refuse_for_gp(args) -> None:
                                                 ("--artifact", args.artifact), ("--baselines", args.baselines),
                                                 ("--tables", args.tables), ("--scenario", args.scenario),
                                                 ("--workers", args.workers)) if value is not None]
-    if args.target != "central":
-        given.insert(0, ("--target", args.target))
+    defaults = (("--target", args.target, "central"), ("--seed", args.seed, "0"), ("--t-img", args.t_img, "1.0"),
+                ("--settle", args.settle, "10.0"))
+    given = [(name, value) for name, value, default in defaults if value != default] + given
     if given:
         raise HostError(f"{given[0][0]} does not apply to --controller {args.controller} "
                         "(paper 004's takeover scenario: its own plant, T = 0.1 s, RK4 0.01 s)")
@@ -193,9 +194,8 @@ def run_gp_example(args: argparse.Namespace) -> int:
           flush=True)
     try:
         with atomic.directory(out) as tmp:
-            m = gp_example.run(args.controller, params, duration, start, out_dir=tmp)["metrics"]
-            m["params"] = str(args.params if args.params is not None else GP_PARAMS)
-            atomic.write_json(tmp / "metrics.json", m)
+            record = {"params": str(args.params if args.params is not None else GP_PARAMS)}
+            m = gp_example.run(args.controller, params, duration, start, out_dir=tmp, record=record)["metrics"]
     except OSError as exc:
         raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
     print("\n".join(gp_summary(m)))

@@ -130,8 +130,9 @@ def gp_metrics(hist: dict, controller: str) -> dict:
 
 
 def run(controller: str, params: GpLawParams, duration: float = DEFAULT_DURATION, start: str = "capture",
-        out_dir: Path | None = None) -> dict:
-    """Metrics (and, with out_dir, metrics.json, history.npz and the figures) of one controller."""
+        out_dir: Path | None = None, record: dict | None = None) -> dict:
+    """Metrics (and, with out_dir, metrics.json, history.npz and the figures) of one controller; `record`
+    (e.g. the law file's path) is added to the metrics."""
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise HostError(f"duration must be a positive number of seconds, got {duration!r}")
     law = controller_for(controller, params)
@@ -144,7 +145,7 @@ def run(controller: str, params: GpLawParams, duration: float = DEFAULT_DURATION
     metrics.update({"wall_time_s": round(time.perf_counter() - clock, 2), "period": float(hist["period"]),
                     "n_inducing": params.n_inducing, "prior_variance": prior_variance(params).tolist(),
                     "artifact_sha256": params.gp.sha256,
-                    "law_sha256": params.sha256(), "law": params.law_mapping(), "paper": PAPER})
+                    "law_sha256": params.sha256(), "law": params.law_mapping(), "paper": PAPER, **(record or {})})
     if out_dir is not None:
         write_outputs(Path(out_dir), metrics, hist)
     return {"metrics": metrics, "history": hist}

@@ -153,6 +153,7 @@ CASES = [
     (["simulate", "--controller", "gp-baseline", "--target", "all", "--out", "{tmp}/s"], "--target does not apply"),
     (["simulate", "--controller", "gp", "--duration", "0", "--out", "{tmp}/s"], "--duration"),
     (["simulate", "--controller", "gp", "--start", "far", "--out", "{tmp}/s"], "invalid choice"),
+    (["simulate", "--controller", "gp", "--seed", "3", "--out", "{tmp}/s"], "--seed does not apply"),
     (["simulate", "--controller", "pid", "--start", "outside", "--out", "{tmp}/s"], "--start applies to"),
     (["simulate", "--controller", "rbf", "--start", "outside", "--out", "{tmp}/s"], "--start applies to"),
     (["gp", "train", "--m", "1", "--out", "{tmp}/g"], "--m must be at least 2"),
