@@ -1,5 +1,6 @@
-"""`staregen report [--evaluate DIR [--tune DIR]] [--rbf DIR ...] --out DIR`: report.md, the figures and one
-self-contained report.html of an evaluation (and a PID tuning, paper 002's runs), each table beside the paper's."""
+"""`staregen report [--evaluate DIR [--tune DIR]] [--rbf DIR ...] [--gp DIR ...] --out DIR`: report.md, the figures
+and one self-contained report.html of an evaluation (and a PID tuning, paper 002's and paper 004's runs), each
+table beside the paper's."""
 from __future__ import annotations
 
 import argparse
@@ -13,10 +14,13 @@ def register(subparsers) -> None:
     p = subparsers.add_parser("report", help="report.md + report.html of a tuning and an evaluation",
                               description=__doc__.splitlines()[0])
     p.add_argument("--evaluate", default=None, metavar="DIR", help="folder written by `staregen evaluate` "
-                   "(paper 001's comparison; --evaluate or --rbf is required)")
+                   "(paper 001's comparison; --evaluate, --rbf or --gp is required)")
     p.add_argument("--rbf", dest="rbf_dirs", action="append", default=[], metavar="DIR",
                    help="folder written by `staregen simulate --controller rbf|rbf-c|rbf-arm` (adds paper 002's "
                         "section; repeatable: e.g. theorem 1, theorem 2, SIL, PIL)")
+    p.add_argument("--gp", dest="gp_dirs", action="append", default=[], metavar="DIR",
+                   help="folder written by `staregen simulate --controller gp-baseline|gp` (adds paper 004's "
+                        "section: baseline against the GP law, both starts; repeatable)")
     p.add_argument("--tune", default=None, metavar="DIR", help="folder written by `staregen tune pid`")
     p.add_argument("--calibration", default=None, metavar="DIR",
                    help="folder written by `staregen calibrate` (adds the section 'Fidelity to paper 001')")
@@ -31,8 +35,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise HostError(f"output folder {out} exists and is not a directory")
-    if args.evaluate is None and not args.rbf_dirs:
-        raise HostError("give --evaluate DIR, --rbf DIR or both")
+    if args.evaluate is None and not args.rbf_dirs and not args.gp_dirs:
+        raise HostError("give --evaluate DIR, --rbf DIR, --gp DIR or several")
     evaluate_dir = Path(args.evaluate) if args.evaluate is not None else None
     if evaluate_dir is not None and not evaluate_dir.is_dir():
         raise HostError(f"--evaluate {evaluate_dir}: not a folder")
@@ -40,6 +44,10 @@ def run(args: argparse.Namespace) -> int:
     for d in rbf_dirs:
         if not d.is_dir():
             raise HostError(f"--rbf {d}: not a folder")
+    gp_dirs = [Path(d) for d in args.gp_dirs]
+    for d in gp_dirs:
+        if not d.is_dir():
+            raise HostError(f"--gp {d}: not a folder")
     tune_dir = Path(args.tune) if args.tune else None
     if tune_dir is not None and not tune_dir.is_dir():
         raise HostError(f"--tune {tune_dir}: not a folder")
@@ -48,6 +56,6 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--calibration {cal_dir}: not a folder")
     if evaluate_dir is None and (tune_dir is not None or cal_dir is not None):
         raise HostError("--tune and --calibration need --evaluate")
-    paths = write_report(out, evaluate_dir, tune_dir, args.commands, cal_dir, rbf_dirs)
+    paths = write_report(out, evaluate_dir, tune_dir, args.commands, cal_dir, rbf_dirs, gp_dirs)
     print(f"wrote {paths['md']} and {paths['html']}")
     return 0

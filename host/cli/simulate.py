@@ -10,8 +10,9 @@ import argparse
 from pathlib import Path
 
 from codegen import artifact as art
+from codegen.units.gp.params import load_params as load_gp_params
 from codegen.units.rbf.params import load_params as load_rbf_params
-from host.sim import rbf_example, tanh_example, tanh_in_loop
+from host.sim import gp_example, rbf_example, tanh_example, tanh_in_loop
 from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
 from host.sim.campaign import format_table, run_campaign, validate_campaign, write_campaign
 from host.control.baselines import load_baselines
@@ -32,6 +33,8 @@ TANH_DEFAULT_DURATION_S = 40.0       # paper 000's example
 RBF_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "rbf_paper002.toml"
 RBF_DEFAULT_DURATION_S = 1000.0      # paper 002, section 3.1
 RBF_MAX_DURATION_S = 20_000.0        # ten hours of a 10 Hz loop in Python: a bound on time and memory
+GP_PARAMS = Path(__file__).resolve().parents[2] / "docs" / "gp_paper004.toml"
+GP_MAX_DURATION_S = 20_000.0
 OWNED = json_marker_owner("metrics.json")   # an earlier simulation's folder: replaced as a whole
 
 
@@ -42,14 +45,18 @@ def register(subparsers) -> None:
                    help=f"controller ({', '.join(sorted(CONTROLLERS))}, or 'tanh' for the paper-000 "
                         "finite-time example, 'tanh-c' / 'tanh-arm' for it with the generated C in the loop: "
                         "SIL x86 / PIL ARM emulator; 'rbf' for paper 002's RBF adaptive law on its tracking "
-                        "scenario, 'rbf-c' / 'rbf-arm' for its generated C in the loop; default pid)")
+                        "scenario, 'rbf-c' / 'rbf-arm' for its generated C in the loop; 'gp-baseline' / 'gp' for "
+                        "paper 004's attitude takeover under the baseline PD / the sparse-GP law; default pid)")
     p.add_argument("--period", default=None,
                    help="tanh and rbf only: control period in s (zero-order hold); tanh: omitted = continuous "
                         "reference; rbf: default 0.1")
     p.add_argument("--dt", default=None, help="tanh and rbf only: plant RK4 step in s (default 5e-4; rbf 0.01)")
     p.add_argument("--params", default=None, metavar="FILE",
-                   help="rbf only: the law's parameter file (default docs/rbf_paper002.toml, theorem 2; "
-                        "docs/rbf_paper002_theorem1.toml for theorem 1)")
+                   help="rbf and gp only: the law's parameter file (rbf: default docs/rbf_paper002.toml, theorem 2; "
+                        "docs/rbf_paper002_theorem1.toml for theorem 1; gp: default docs/gp_paper004.toml, M = 20)")
+    p.add_argument("--start", default=None, choices=gp_example.STARTS,
+                   help="gp-baseline and gp only: 'capture' (default, the post-capture state) or 'outside' "
+                        "(60 deg off, outside the GP's training data: the paper's Fig. 7)")
     p.add_argument("--artifact", default=None, metavar="FILE",
                    help="model artifact for the network controllers (nn, nn-c, pid-c, nn-arm); "
                         "default: a stand-in network fitted to the PID law")
@@ -59,7 +66,7 @@ def register(subparsers) -> None:
                    help="discrete-point tables for dp / dp-c (`staregen dp build`)")
     p.add_argument("--target", default="central",
                    help="'central' (120E 30N), 'all' (the 100 seeded targets) or 'LON,LAT' in degrees")
-    p.add_argument("--duration", default=None, help="simulated seconds (default 100; tanh 40, rbf 1000)")
+    p.add_argument("--duration", default=None, help="simulated seconds (default 100; tanh 40, rbf 1000, gp 600)")
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
     add_scenario_argument(p)
     p.add_argument("--t-img", default="1.0", help="imaging window length T_img in s (default 1)")
@@ -160,6 +167,61 @@ def rbf_summary(m: dict) -> list[str]:
     return lines
 
 
+def _refuse_for_gp(args) -> None:
+    """One line for an option the takeover scenario does not use (its own plant, period and start)."""
+    given = [(name, value) for name, value in (("--period", args.period), ("--dt", args.dt),
+                                                ("--artifact", args.artifact), ("--baselines", args.baselines),
+                                                ("--tables", args.tables), ("--scenario", args.scenario),
+                                                ("--workers", args.workers)) if value is not None]
+    defaults = (("--target", args.target, "central"), ("--seed", args.seed, "0"), ("--t-img", args.t_img, "1.0"),
+                ("--settle", args.settle, "10.0"))
+    given = [(name, value) for name, value, default in defaults if value != default] + given
+    if given:
+        raise HostError(f"{given[0][0]} does not apply to --controller {args.controller} "
+                        "(paper 004's takeover scenario: its own plant, T = 0.1 s, RK4 0.01 s)")
+
+
+def run_gp_example(args: argparse.Namespace) -> int:
+    """Paper 004's attitude takeover (section 1) flown by the baseline PD or the GP law of the law's file."""
+    _refuse_for_gp(args)
+    params = load_gp_params(args.params if args.params is not None else GP_PARAMS)
+    duration = parse_number(str(gp_example.DEFAULT_DURATION) if args.duration is None else args.duration,
+                            "--duration", positive=True, maximum=GP_MAX_DURATION_S)
+    start = args.start or "capture"
+    out = Path(args.out)
+    check_output_folder(out, OWNED, [args.params])
+    print(f"{args.controller}: paper 004 takeover, start {start}, {duration:g} s, M = {params.n_inducing} ...",
+          flush=True)
+    try:
+        with atomic.directory(out) as tmp:
+            record = {"params": str(args.params if args.params is not None else GP_PARAMS)}
+            m = gp_example.run(args.controller, params, duration, start, out_dir=tmp, record=record)["metrics"]
+    except OSError as exc:
+        raise HostError(f"cannot write output folder {out}: {exc.strerror or exc}") from None
+    print("\n".join(gp_summary(m)))
+    print(f"wrote {out}/metrics.json")
+    return 0
+
+
+def _band(x) -> str:
+    return rbf_example.format_seconds(x)
+
+
+def gp_summary(m: dict) -> list[str]:
+    lines = [f"  error within 1 deg / 0.1 deg (to stay) {_band(m['t_settle_1deg'])} / {_band(m['t_settle_0p1deg'])}; "
+             f"last 60 s mean {m['steady_error_deg_mean']:.3g} deg, max {m['steady_error_deg_max']:.3g} deg",
+             "  torque RMS " + ", ".join(f"{v:.3f}" for v in m["torque_rms"]) + f" N*m, max |u| {m['max_abs_torque']:.3f}",
+             "  wheel momentum at the end " + ", ".join(f"{v:.1f}" for v in m["h_w_end"]) + " N*m*s; 50 N*m*s at "
+             + ", ".join("-" if v is None else f"{v:.0f} s" for v in m["t_momentum_limit"]),
+             "  gains (K1, K2) first / last 60 s " + ", ".join(f"{v:.2f}" for v in m["gains_first_60s"]) + " / "
+             + ", ".join(f"{v:.2f}" for v in m["gains_last_60s"])]
+    if m["var_fraction_first_60s"] is not None:
+        lines.append(f"  variance fraction s first / last 60 s {m['var_fraction_first_60s']:.3g} / "
+                     f"{m['var_fraction_last_60s']:.3g} (max {m['var_fraction_max']:.3g}); GP mean RMS error "
+                     + ", ".join(f"{v:.2e}" for v in m["mu_rms_error"]) + " N*m")
+    return lines
+
+
 def controller_options(args) -> dict:
     """Factory options: the artifact of a network controller, the baselines file of a fitted
     baseline (each checked here: a clear user error)."""
@@ -192,10 +254,14 @@ def controller_options(args) -> dict:
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.controller in gp_example.CONTROLLERS:
+        return run_gp_example(args)
+    if args.start is not None:
+        raise HostError(f"--start applies to --controller {', '.join(gp_example.CONTROLLERS)} only")
     if args.controller in rbf_example.CONTROLLERS:
         return run_rbf_example(args)
     if args.params is not None:
-        raise HostError("--params applies to --controller rbf, rbf-c, rbf-arm only")
+        raise HostError("--params applies to --controller rbf, rbf-c, rbf-arm, gp-baseline, gp only")
     if args.controller in ("tanh", "tanh-c", "tanh-arm"):
         return run_tanh_example(args)
     if args.period is not None or args.dt is not None:

@@ -10,6 +10,11 @@ Regulation to q_d = [0, 0, 0, 1], ω_d = 0: the attitude error is the measured q
 chosen with q4 ≥ 0, the shorter way round, as the GP's training data). The GP is any object with
 `predict(x (9,)) -> (mean (3,), variance (3,))` in N·m and (N·m)²; its prior variance per axis (the
 variance far from the data) normalises the schedule.
+
+From the law's parameter file (codegen.units.gp.params.GpLawParams: the trained artifact, the gain
+bounds, torque limit and J_s): `gp_law(params)` flies the artifact through `ArtifactPredictor`
+(float64, codegen.units.gp.artifact.reference_predict on the artifact's arrays; prior variance per
+axis s_y,k² σ_f²), `baseline_law(params)` the same gains' lower bounds without the GP.
 """
 from __future__ import annotations
 
@@ -18,6 +23,8 @@ from typing import NamedTuple, Protocol
 
 import numpy as np
 
+from codegen.units.gp.artifact import GpArrays, reference_predict
+from codegen.units.gp.params import GpLawParams
 from host.core.vec3 import cross3
 from host.errors import HostError
 from host.plant.spacecraft import TABLE6_INERTIA
@@ -115,3 +122,38 @@ class GpLaw:
         K = self.gains.scheduled(variance_fraction(var, self.prior_variance))
         u = pd_torque(attitude_error(q), omega, h_w, K[0], K[1], self.prior_inertia) - mu
         return LawOutput(np.clip(u, -self.torque_max, self.torque_max), mu, var, K)
+
+
+# ----------------------------------------------------------------------------- from the law's file
+
+
+@dataclass(frozen=True)
+class ArtifactPredictor:
+    """The trained GP of an artifact, float64 (reference_predict): latent mean and variance of d."""
+
+    arrays: GpArrays
+
+    def predict(self, x) -> tuple[np.ndarray, np.ndarray]:
+        mean, var = reference_predict(self.arrays, np.asarray(x, dtype=float).reshape(1, -1))
+        return mean[0], var[0]
+
+    @property
+    def prior_variance(self) -> np.ndarray:
+        """s_y,k² σ_f² per axis, (N·m)²: the latent variance far from the data (without the jitter)."""
+        return np.asarray(self.arrays.output_scale, float) ** 2 * float(self.arrays.outputscale)
+
+
+def file_gains(params: GpLawParams) -> Gains:
+    return Gains(params.k1, params.k1_bar, params.k2, params.k2_bar)
+
+
+def gp_law(params: GpLawParams) -> GpLaw:
+    """The GP law of the parameter file: its artifact, gain bounds, torque limit and J_s."""
+    predictor = ArtifactPredictor(params.gp.arrays)
+    return GpLaw(predictor, predictor.prior_variance, file_gains(params), np.array(params.inertia, dtype=float),
+                 float(params.torque_max))
+
+
+def baseline_law(params: GpLawParams) -> BaselineLaw:
+    """The baseline PD of the parameter file: gains k1, k2 (the GP law's lower bounds), torque limit, J_s."""
+    return BaselineLaw(file_gains(params), np.array(params.inertia, dtype=float), float(params.torque_max))

@@ -261,15 +261,105 @@ def rbf_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
     return out
 
 
+GP_CLAIMS = {"settle": "the GP law settles faster and to a smaller set than the baseline (L35, Figs. 4-6)",
+             "fig7": "variance and gains rise outside the training region (L36, Fig. 7)"}
+
+
+def _first_time(times) -> str:
+    known = [t for t in times if t is not None]
+    return "not reached" if not known else f"{min(known):.0f}"
+
+
+def _gp_row(m: dict) -> tuple:
+    vf = (m["var_fraction_first_60s"], m["var_fraction_last_60s"])
+    return (m["controller"], m["start"], str(m["n_inducing"]) if m["controller"] != "gp-baseline" else "-",
+            _band_time(m["t_settle_1deg"]), _band_time(m["t_settle_0p1deg"]),
+            f"{m['steady_error_deg_mean']:.3g} / {m['steady_error_deg_max']:.3g}",
+            ", ".join(f"{v:.3f}" for v in m["torque_rms"]), f"{m['max_abs_torque']:.3f}",
+            ", ".join(f"{v:.1f}" for v in m["h_w_end"]), _first_time(m["t_momentum_limit"]),
+            "-" if vf[0] is None else f"{vf[0]:.3g} / {vf[1]:.3g}",
+            f"{m['gains_first_60s'][0]:.2f} / {m['gains_last_60s'][0]:.2f}",
+            f"{m['gains_first_60s'][1]:.1f} / {m['gains_last_60s'][1]:.1f}")
+
+
+def _settled_sooner(a, b) -> bool:
+    """Time a (None = never) is earlier than time b."""
+    return a is not None and (b is None or a < b)
+
+
+def _gp_settle_reading(runs: list[dict]) -> list[str]:
+    """Per start with both laws: does the GP law settle faster (1°) and to a smaller set (last 60 s)?"""
+    out = []
+    for start in sorted({m["start"] for m in runs}):
+        base = next((m for m in runs if m["start"] == start and m["controller"] == "gp-baseline"), None)
+        law = next((m for m in runs if m["start"] == start and m["controller"] != "gp-baseline"), None)
+        if base is None or law is None:
+            continue
+        faster = _settled_sooner(law["t_settle_1deg"], base["t_settle_1deg"])
+        smaller = law["steady_error_deg_mean"] < base["steady_error_deg_mean"]
+        verdict = "holds" if faster and smaller else "does not hold"
+        out.append(f"start {start}: {verdict} — within 1° from {format_seconds(law['t_settle_1deg'])} vs "
+                   f"{format_seconds(base['t_settle_1deg'])}; last-60 s mean error {law['steady_error_deg_mean']:.3g}° "
+                   f"vs {base['steady_error_deg_mean']:.3g}°.")
+    return out
+
+
+def _k1_bounds(m: dict) -> str:
+    law = m.get("law")
+    ok = isinstance(law, dict) and all(isinstance(law.get(k), (int, float)) for k in ("k1", "k1_bar"))
+    return f" (bounds {law['k1']:g}-{law['k1_bar']:g})" if ok else ""
+
+
+def _gp_fig7_reading(runs: list[dict]) -> list[str]:
+    """GP runs from both starts: is the first minute's variance fraction (and K1) higher outside?"""
+    law = {m["start"]: m for m in runs if m["controller"] != "gp-baseline"}
+    if "capture" not in law or "outside" not in law:
+        return []
+    cap, out = law["capture"], law["outside"]
+    rises = (out["var_fraction_first_60s"] > cap["var_fraction_first_60s"]
+             and out["gains_first_60s"][0] > cap["gains_first_60s"][0])
+    return [f"{'holds' if rises else 'does not hold'} — first 60 s: variance fraction s {out['var_fraction_first_60s']:.3g} "
+            f"(outside) vs {cap['var_fraction_first_60s']:.3g} (capture), K1 {out['gains_first_60s'][0]:.2f} vs "
+            f"{cap['gains_first_60s'][0]:.2f} N·m{_k1_bounds(out)}; last 60 s outside: s {out['var_fraction_last_60s']:.3g}, "
+            f"K1 {out['gains_last_60s'][0]:.2f}."]
+
+
+def gp_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
+    """Paper 004's takeover (`staregen simulate --controller gp-baseline|gp`): baseline against the GP law
+    beside the paper's qualitative claims (its numbers are lost), and the figures."""
+    out = [Block("h2", "Paper 004: sparse-GP learning control for the combined-spacecraft attitude takeover"),
+           Block("table", header=("law", "start", "M", "within 1° [s]", "within 0.1° [s]",
+                                  "last 60 s error mean / max [°]", "torque RMS x, y, z [N·m]", "max |u| [N·m]",
+                                  "h_w at end [N·m·s]", "50 N·m·s at [s]", "s first / last 60 s",
+                                  "K1 first / last 60 s [N·m]", "K2 first / last 60 s [N·m·s/rad]"),
+                 rows=tuple(_gp_row(m) for m in runs)),
+           Block("p", "Times are 'to stay within the band'; '50 N·m·s at' extrapolates the last minute's wheel-momentum "
+                      "slope (earliest axis); s = max_k σ²_k/σ²_prior,k, the gain schedule's variable "
+                      "(docs/gp-takeover.md §5, §12).")]
+    out += [Block("p", f"Paper: {GP_CLAIMS['settle']}. Ours, {line}") for line in _gp_settle_reading(runs)]
+    out += [Block("p", f"Paper: {GP_CLAIMS['fig7']}. Ours, {line}") for line in _gp_fig7_reading(runs)]
+    captions = {"fig4_attitude.png": "attitude error angle and q_v (the paper's Fig. 4)",
+                "fig5_rates.png": "angular velocity (Fig. 5)", "fig6_torque.png": "torque and wheel momentum (Fig. 6)",
+                "fig7_variance_gains.png": "normalised variance and gains (Fig. 7)",
+                "fig_gp_mean.png": "the GP mean against the true unknown term"}
+    for name, path in figures.items():
+        run, _, fig = name.partition("_")
+        m = runs[int(run) - 1]
+        out.append(Block("img", text=f"run {run} ({m['controller']}, start {m['start']}): {captions.get(fig, fig)}",
+                         path=str(path)))
+    return out
+
+
 def build(evaluation: dict | None, tuning: dict | None, figures: dict[str, Path], run_facts: dict,
           calibration: dict | None = None, calibration_figure: Path | None = None,
-          rbf_runs: list[dict] = (), rbf_figures: dict[str, Path] | None = None) -> list[Block]:
+          rbf_runs: list[dict] = (), rbf_figures: dict[str, Path] | None = None,
+          gp_runs: list[dict] = (), gp_figures: dict[str, Path] | None = None) -> list[Block]:
     title = "staregen: tuning and evaluation against paper 001 §7" if evaluation else "staregen report"
     blocks = [Block("h1", title)]
     facts = ", ".join(f"{k} {v}" for k, v in run_facts.items())
     blocks.append(Block("p", f"Run: {facts}."))
     if evaluation is None:
-        return blocks + rbf_blocks(list(rbf_runs), rbf_figures or {})
+        return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures)
     plan = evaluation.get("plan")
     if plan:
         blocks.append(Block("p", f"Evaluation plan: {plan['targets']} staring targets × {plan['duration']:g} s, step "
@@ -319,9 +409,13 @@ def build(evaluation: dict | None, tuning: dict | None, figures: dict[str, Path]
     blocks.append(Block("h2", "Figures"))
     for name, path in figures.items():
         blocks.append(Block("img", text=captions.get(name, name), path=str(path)))
-    if rbf_runs:
-        blocks += rbf_blocks(list(rbf_runs), rbf_figures or {})
-    return blocks
+    return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures)
+
+
+def _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures) -> list[Block]:
+    """The sections of papers 002 and 004, each only when it has runs."""
+    out = rbf_blocks(list(rbf_runs), rbf_figures or {}) if rbf_runs else []
+    return out + (gp_blocks(list(gp_runs), gp_figures or {}) if gp_runs else [])
 
 
 def _md(text) -> str:
@@ -374,6 +468,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 MAX_FIGURE_BYTES = 64 << 20
 FIGURES = ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png")
 RBF_FIGURES = ("fig_range_los.png", "fig_attitude.png", "fig_rbf_estimate.png", "fig_c_vs_float64.png")
+GP_FIGURES = ("fig4_attitude.png", "fig5_rates.png", "fig6_torque.png", "fig7_variance_gains.png", "fig_gp_mean.png")
 
 
 def _read_figure(path: Path) -> bytes | None:
@@ -396,7 +491,7 @@ def _read_figure(path: Path) -> bytes | None:
 
 
 def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_dir: Path | None,
-                 rbf_dirs: list[Path] = ()) -> dict:
+                 rbf_dirs: list[Path] = (), gp_dirs: list[Path] = ()) -> dict:
     """Every input of the report, checked, before anything is written (the documents first)."""
     return {
         "evaluation": documents.read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)",
@@ -405,6 +500,10 @@ def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_d
                                "staregen simulate --controller rbf") for d in rbf_dirs],
         "rbf_figures": {f"{i + 1}_{name}": data for i, d in enumerate(rbf_dirs) for name in RBF_FIGURES
                         if (data := _read_figure(d / name)) is not None},
+        "gp": [documents.read(d / "metrics.json", "GP takeover run (metrics.json)", documents.GP_RUN,
+                              "staregen simulate --controller gp-baseline|gp") for d in gp_dirs],
+        "gp_figures": {f"{i + 1}_{name}": data for i, d in enumerate(gp_dirs) for name in GP_FIGURES
+                       if (data := _read_figure(d / name)) is not None},
         "tuning": documents.read(tune_dir / "result.json", "tuning result (result.json)", documents.TUNING,
                                  "staregen tune pid") if tune_dir else None,
         "calibration": documents.read(calibration_dir / "calibration.json", "calibration (calibration.json)",
@@ -416,12 +515,14 @@ def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_d
 
 
 def write_report(out: Path, evaluate_dir: Path | None, tune_dir: Path | None, commands: list[str],
-                 calibration_dir: Path | None = None, rbf_dirs: list[Path] = ()) -> dict[str, Path]:
-    inputs = _read_inputs(evaluate_dir, tune_dir, calibration_dir, rbf_dirs)
+                 calibration_dir: Path | None = None, rbf_dirs: list[Path] = (),
+                 gp_dirs: list[Path] = ()) -> dict[str, Path]:
+    inputs = _read_inputs(evaluate_dir, tune_dir, calibration_dir, rbf_dirs, gp_dirs)
     evaluation, tuning, calibration = inputs["evaluation"], inputs["tuning"], inputs["calibration"]
     out.mkdir(parents=True, exist_ok=True)
     figures = {name: atomic.write_bytes(out / name, data) for name, data in inputs["figures"].items()}
     rbf_figures = {name: atomic.write_bytes(out / f"rbf{name}", data) for name, data in inputs["rbf_figures"].items()}
+    gp_figures = {name: atomic.write_bytes(out / f"gp{name}", data) for name, data in inputs["gp_figures"].items()}
     cal_figure = None
     if inputs["calibration_figure"] is not None:
         cal_figure = atomic.write_bytes(out / "fig_ratio_vs_noise.png", inputs["calibration_figure"])
@@ -433,7 +534,8 @@ def write_report(out: Path, evaluate_dir: Path | None, tune_dir: Path | None, co
         facts["tuning wall time [s]"] = tuning.get("timing", {}).get("wall_seconds")
     if commands:
         facts["commands"] = "; ".join(commands)
-    blocks = build(evaluation, tuning, figures, facts, calibration, cal_figure, inputs["rbf"], rbf_figures)
+    blocks = build(evaluation, tuning, figures, facts, calibration, cal_figure, inputs["rbf"], rbf_figures,
+                   inputs["gp"], gp_figures)
     paths = {"md": atomic.write_text(out / "report.md", to_markdown(blocks)),
              "html": atomic.write_text(out / "report.html", to_html(blocks))}
     return paths

@@ -82,6 +82,15 @@ RBF_RUN = {
 }
 RBF_IN_LOOP = ("golden_mismatch_steps", "max_rho_diff_m", "max_attitude_diff_deg")   # all or none
 
+# `staregen simulate --controller gp-baseline|gp` (host.sim.gp_example): the fields the report reads
+GP_RUN = {
+    "controller": TEXT, "start": TEXT, "duration": POSITIVE, "n_inducing": COUNT,
+    "t_settle_1deg": MAYBE_TIME, "t_settle_0p1deg": MAYBE_TIME, "steady_error_deg_mean": NONNEG,
+    "steady_error_deg_max": NONNEG, "torque_rms": ListOf(NONNEG, 3), "max_abs_torque": NONNEG,
+    "h_w_end": XYZ, "t_momentum_limit": ListOf(Maybe(REAL), 3), "gains_first_60s": ListOf(REAL, 2),
+    "gains_last_60s": ListOf(REAL, 2), "var_fraction_first_60s": Maybe(NONNEG), "var_fraction_last_60s": Maybe(NONNEG),
+}
+
 
 def _label(value) -> str:
     """A value for an error line: short, on one line (a container by its type)."""

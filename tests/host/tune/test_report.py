@@ -185,7 +185,7 @@ def test_the_rbf_section_puts_paper_002_beside_each_run(tmp_path):
 
 def test_bad_rbf_inputs_are_one_line(tmp_path, capsys):
     assert main(["report", "--out", str(tmp_path / "r")]) == 2
-    assert "give --evaluate DIR, --rbf DIR or both" in capsys.readouterr().err
+    assert "give --evaluate DIR, --rbf DIR, --gp DIR or several" in capsys.readouterr().err
     assert main(["report", "--rbf", str(tmp_path / "none"), "--out", str(tmp_path / "r")]) == 2
     assert "--rbf" in capsys.readouterr().err
     bad = _rbf_run(tmp_path / "bad", t_rho_5m="soon")
@@ -202,3 +202,54 @@ def test_bad_rbf_inputs_are_one_line(tmp_path, capsys):
     assert main(["report", "--rbf", str(good), "--tune", str(good), "--out", str(tmp_path / "r")]) == 2
     assert "--tune and --calibration need --evaluate" in capsys.readouterr().err
     assert not (tmp_path / "r").exists()
+
+
+# ----------------------------------------------------------------------------- paper 004 (--gp)
+
+GP_METRICS = {"controller": "gp", "start": "capture", "duration": 600.0, "n_inducing": 20, "t_settle_1deg": 150.2,
+              "t_settle_0p1deg": 330.0, "steady_error_deg_mean": 0.012, "steady_error_deg_max": 0.02,
+              "torque_rms": [0.14, 0.25, 0.22], "max_abs_torque": 1.0, "h_w_end": [38.0, -40.7, 45.2],
+              "t_momentum_limit": [None, 824.0, 686.0], "gains_first_60s": [4.2, 73.1], "gains_last_60s": [4.01, 72.05],
+              "var_fraction_first_60s": 0.017, "var_fraction_last_60s": 0.001}
+BASE_METRICS = {**GP_METRICS, "controller": "gp-baseline", "t_settle_1deg": None, "t_settle_0p1deg": None,
+                "steady_error_deg_mean": 2.215, "steady_error_deg_max": 2.3, "gains_first_60s": [4.0, 72.0],
+                "gains_last_60s": [4.0, 72.0], "var_fraction_first_60s": None, "var_fraction_last_60s": None}
+
+
+def _gp_run(folder, base=GP_METRICS, **changes):
+    folder.mkdir()
+    (folder / "metrics.json").write_text(json.dumps({**base, **changes}))
+    return folder
+
+
+def test_the_gp_section_puts_baseline_and_gp_law_beside_the_papers_claims(tmp_path):
+    runs = [_gp_run(tmp_path / "b", BASE_METRICS), _gp_run(tmp_path / "g"),
+            _gp_run(tmp_path / "go", start="outside", var_fraction_first_60s=0.13, gains_first_60s=[5.5, 81.0],
+                    law={"k1": 4.0, "k1_bar": 16.0}),
+            _gp_run(tmp_path / "bo", BASE_METRICS, start="outside", steady_error_deg_mean=0.001, t_settle_1deg=90.0)]
+    (runs[1] / "fig7_variance_gains.png").write_bytes(b"\x89PNG\r\n\x1a\n" + b"0" * 16)
+    argv = ["report", "--out", str(tmp_path / "r")]
+    for r in runs:
+        argv += ["--gp", str(r)]
+    assert main(argv) == 0
+    md = (tmp_path / "r" / "report.md").read_text()
+    assert "Paper 004" in md
+    assert "| gp-baseline | capture | \\- | not reached | not reached | 2.21 / 2.3 |" in md
+    assert "| gp | capture | 20 | 150.2 | 330.0 | 0.012 / 0.02 | 0.140, 0.250, 0.220 | 1.000 |" in md
+    assert "| 686 | 0.017 / 0.001 | 4.20 / 4.01 | 73.1 / 72.0 |" in md       # earliest axis to 50 N·m·s
+    assert "Ours, start capture: holds — within 1° from 150.2 s vs not reached;" in md
+    assert "Ours, start outside: does not hold" in md                     # the baseline settled sooner there
+    assert "Ours, holds — first 60 s: variance fraction s 0.13 (outside) vs 0.017 (capture), K1 5.50 vs 4.20 N·m " \
+           "(bounds 4-16)" in md
+    assert (tmp_path / "r" / "gp2_fig7_variance_gains.png").exists()
+    assert "run 2 (gp, start capture): normalised variance and gains (Fig. 7)" in md
+
+
+def test_bad_gp_inputs_are_one_line(tmp_path, capsys):
+    assert main(["report", "--gp", str(tmp_path / "none"), "--out", str(tmp_path / "r")]) == 2
+    assert "--gp" in capsys.readouterr().err
+    bad = _gp_run(tmp_path / "bad", start=3)
+    assert main(["report", "--gp", str(bad), "--out", str(tmp_path / "r")]) == 2
+    err = capsys.readouterr().err
+    assert "not written by `staregen simulate --controller gp-baseline|gp`" in err and "start" in err
+    assert err.count("\n") == 1 and not (tmp_path / "r").exists()
