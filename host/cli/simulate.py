@@ -46,7 +46,8 @@ def register(subparsers) -> None:
                         "finite-time example, 'tanh-c' / 'tanh-arm' for it with the generated C in the loop: "
                         "SIL x86 / PIL ARM emulator; 'rbf' for paper 002's RBF adaptive law on its tracking "
                         "scenario, 'rbf-c' / 'rbf-arm' for its generated C in the loop; 'gp-baseline' / 'gp' for "
-                        "paper 004's attitude takeover under the baseline PD / the sparse-GP law; default pid)")
+                        "paper 004's attitude takeover under the baseline PD / the sparse-GP law, 'gp-c' / 'gp-arm' "
+                        "for the GP law's generated C in the loop; default pid)")
     p.add_argument("--period", default=None,
                    help="tanh and rbf only: control period in s (zero-order hold); tanh: omitted = continuous "
                         "reference; rbf: default 0.1")
@@ -215,6 +216,13 @@ def gp_summary(m: dict) -> list[str]:
              + ", ".join("-" if v is None else f"{v:.0f} s" for v in m["t_momentum_limit"]),
              "  gains (K1, K2) first / last 60 s " + ", ".join(f"{v:.2f}" for v in m["gains_first_60s"]) + " / "
              + ", ".join(f"{v:.2f}" for v in m["gains_last_60s"])]
+    if "golden_mismatch_steps" in m:
+        lines.append(f"  {m['mode']}: {m['golden_mismatch_steps']} steps differ from the golden model; against "
+                     f"float64: |d angle| <= {m['max_angle_diff_deg']:.2e} deg, |d torque| <= {m['max_torque_diff']:.2e} "
+                     f"N*m, |d mu| <= {m['max_mu_diff']:.2e} N*m")
+    if "cycles_max" in m:
+        lines.append(f"  cycles per step (ideal memory) min {m['cycles_min']}, median {m['cycles_median']}, "
+                     f"max {m['cycles_max']}")
     if m["var_fraction_first_60s"] is not None:
         lines.append(f"  variance fraction s first / last 60 s {m['var_fraction_first_60s']:.3g} / "
                      f"{m['var_fraction_last_60s']:.3g} (max {m['var_fraction_max']:.3g}); GP mean RMS error "

@@ -8,12 +8,11 @@ float64) on the takeover plant (host.sim.takeover.simulate: RK4 0.01 s, ZOH 0.1 
 capture axis, outside the 25° ball of the training data, same residual rates, wheels at rest; the
 target still pulls towards its capture pointing).
 
-Seam for the generated C in the loop ("gp-c", "gp-arm": not built here): `fly(controller, ...)` takes
-any closed-loop controller object `(t, q, ω, h_w) -> LawOutput` (host.sim.takeover.Controller), and
-`record_controller(step)` adapts a unit step on the records of the unit `gp` (input {q[4] scalar last,
-reference -> body, omega[3] rad/s, h_w[3] N·m·s}, output {torque[3], mu[3], var[3], gains[2] (K1, K2),
-status}) to that interface, e.g. `record_controller(InTheLoop(configure_unit("gp", ...), "x86").step)`
-as host.sim.rbf_example does; `controller_for` is the one place that maps a name to a controller.
+The generated unit `gp` in the loop: "gp-c" (SIL, the x86 build through cffi) and "gp-arm" (PIL, the
+ARM ELF in the emulator, cycles of every step), through tools.inloop.InTheLoop with the golden twin
+stepping alongside (every output word compared); `record_controller(step)` adapts a step on the unit's
+records to the closed-loop interface. Their metrics add the float64 run of the same file ("gp") and
+the largest differences from it.
 """
 from __future__ import annotations
 
@@ -30,15 +29,20 @@ import numpy as np  # noqa: E402
 
 from codegen import atomic  # noqa: E402
 from codegen.units.gp.params import GpLawParams  # noqa: E402
+from codegen.units.gp.records import INPUT_DTYPE  # noqa: E402
 from host.control.takeover_laws import LawOutput, baseline_law, gp_law, variance_fraction  # noqa: E402
 from host.core.constants import DEG  # noqa: E402
 from host.errors import HostError  # noqa: E402
 from host.plant.spacecraft import pack_state  # noqa: E402
 from host.plant.takeover import CAPTURE_AXIS, CAPTURE_RATE, TakeoverPlant, axis_angle_quat, capture_state  # noqa: E402
 from host.sim.plots import save_figure  # noqa: E402
+from host.sim.scenarios import configure_unit  # noqa: E402
 from host.sim.takeover import Controller, law_controller, metrics_of, simulate  # noqa: E402
+from tools.inloop import InTheLoop  # noqa: E402
 
-CONTROLLERS = ("gp-baseline", "gp")
+CONTROLLERS = ("gp-baseline", "gp", "gp-c", "gp-arm")
+TARGETS = {"gp-c": "x86", "gp-arm": "arm"}
+TARGET_NAMES = {"x86": "SIL x86", "arm": "PIL ARM emulator"}
 STARTS = ("capture", "outside")
 DEFAULT_DURATION = 600.0       # s
 OUTSIDE_ANGLE = 60.0 * DEG     # rad, about the capture axis (training data: setpoints within 25°)
@@ -54,25 +58,34 @@ AXES = ("x", "y", "z")
 # ----------------------------------------------------------------------------- controllers
 
 
-RecordStep = Callable[[dict], dict]
+RecordStep = Callable[[np.ndarray], np.ndarray]
 
 
 def record_controller(step: RecordStep) -> Controller:
-    """A unit step on the gp unit's records as a closed-loop controller (float32 in, float64 out)."""
+    """A unit step on the gp unit's records (one INPUT_DTYPE record in, one output record out) as a
+    closed-loop controller (float32 in, float64 out)."""
     def controller(t, q, omega, h_w) -> LawOutput:
-        out = step({"q": np.asarray(q, np.float32), "omega": np.asarray(omega, np.float32),
-                    "h_w": np.asarray(h_w, np.float32)})
+        rec = np.zeros(1, dtype=INPUT_DTYPE)
+        rec["q"], rec["omega"], rec["h_w"] = q, omega, h_w
+        out = np.asarray(step(rec)).reshape(-1)[0]
         return LawOutput(*(np.asarray(out[k], dtype=float).reshape(n) for k, n in
                            (("torque", 3), ("mu", 3), ("var", 3), ("gains", 2))))
     return controller
 
 
-def controller_for(name: str, params: GpLawParams) -> Controller:
-    """The closed-loop controller of a name (gp-c / gp-arm would be added here)."""
+def unit_loop(name: str, params: GpLawParams) -> InTheLoop:
+    """The generated unit on the target of gp-c / gp-arm, its golden twin alongside."""
+    return InTheLoop(configure_unit("gp", params=params), TARGETS[name])
+
+
+def controller_for(name: str, params: GpLawParams, loop: InTheLoop | None = None) -> Controller:
+    """The closed-loop controller of a name (gp-c / gp-arm fly `loop`, made by unit_loop if not given)."""
     if name == "gp-baseline":
         return law_controller(baseline_law(params))
     if name == "gp":
         return law_controller(gp_law(params))
+    if name in TARGETS:
+        return record_controller((loop or unit_loop(name, params)).step)
     raise HostError(f"unknown controller {name!r} ({', '.join(CONTROLLERS)})")
 
 
@@ -135,20 +148,43 @@ def run(controller: str, params: GpLawParams, duration: float = DEFAULT_DURATION
     (e.g. the law file's path) is added to the metrics."""
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise HostError(f"duration must be a positive number of seconds, got {duration!r}")
-    law = controller_for(controller, params)
+    if controller not in CONTROLLERS:
+        raise HostError(f"unknown controller {controller!r} ({', '.join(CONTROLLERS)})")
     if start not in STARTS:
         raise HostError(f"unknown start {start!r} ({', '.join(STARTS)})")
+    loop = unit_loop(controller, params) if controller in TARGETS else None
     clock = time.perf_counter()
-    hist = fly(law, params, duration, start)
+    hist = fly(controller_for(controller, params, loop), params, duration, start)
     metrics = {"controller": controller, "start": start, **metrics_of(hist), **gp_metrics(hist, controller)}
     metrics["max_abs_torque"] = float(np.max(np.abs(hist["torque_applied"][:-1])))
     metrics.update({"wall_time_s": round(time.perf_counter() - clock, 2), "period": float(hist["period"]),
                     "n_inducing": params.n_inducing, "prior_variance": prior_variance(params).tolist(),
                     "artifact_sha256": params.gp.sha256,
                     "law_sha256": params.sha256(), "law": params.law_mapping(), "paper": PAPER, **(record or {})})
+    if loop is not None:
+        metrics.update(in_the_loop_metrics(loop, hist, fly(controller_for("gp", params), params, duration, start)))
     if out_dir is not None:
         write_outputs(Path(out_dir), metrics, hist)
     return {"metrics": metrics, "history": hist}
+
+
+def in_the_loop_metrics(loop: InTheLoop, hist: dict, reference: dict) -> dict:
+    """The C run against its golden twin (mismatching steps) and against the float64 law (largest
+    differences of the error angle, torque, mean and variance over the run; the float64 metrics)."""
+    n = len(hist["t"]) - 1
+    ref_metrics = metrics_of(reference)
+    out = {"mode": TARGET_NAMES[loop.target],
+           "golden_mismatch_steps": int(loop.mismatch_steps),
+           "max_angle_diff_deg": float(np.max(np.abs(hist["angle"] - reference["angle"])) / DEG),
+           "max_torque_diff": float(np.max(np.abs(hist["torque"][:n] - reference["torque"][:n]))),
+           "max_mu_diff": float(np.max(np.abs(hist["mu"][:n] - reference["mu"][:n]))),
+           "max_var_fraction_diff": float(np.nanmax(np.abs(hist["var_fraction"][:n] - reference["var_fraction"][:n]))),
+           "float64": {k: ref_metrics[k] for k in ref_metrics if k.startswith(("t_", "steady"))}}
+    cycles = loop.cycles
+    if cycles:
+        out.update({"cycles_min": int(min(cycles)), "cycles_median": int(np.median(cycles)),
+                    "cycles_max": int(max(cycles))})
+    return out
 
 
 # ----------------------------------------------------------------------------- outputs

@@ -292,7 +292,7 @@ def _gp_settle_reading(runs: list[dict]) -> list[str]:
     out = []
     for start in sorted({m["start"] for m in runs}):
         base = next((m for m in runs if m["start"] == start and m["controller"] == "gp-baseline"), None)
-        law = next((m for m in runs if m["start"] == start and m["controller"] != "gp-baseline"), None)
+        law = _gp_law_run(runs, start)
         if base is None or law is None:
             continue
         faster = _settled_sooner(law["t_settle_1deg"], base["t_settle_1deg"])
@@ -304,6 +304,26 @@ def _gp_settle_reading(runs: list[dict]) -> list[str]:
     return out
 
 
+def _gp_law_run(runs: list[dict], start: str) -> dict | None:
+    """The GP law's run from a start: the float64 one if given, else a C one (gp-c, gp-arm)."""
+    laws = [m for m in runs if m["start"] == start and m["controller"] != "gp-baseline"]
+    return next((m for m in laws if m["controller"] == "gp"), laws[0] if laws else None)
+
+
+def _gp_in_the_loop(runs: list[dict]) -> list[str]:
+    """The generated C's runs: golden mismatches, differences from float64, cycles (PIL)."""
+    out = []
+    for m in runs:
+        if "golden_mismatch_steps" not in m:
+            continue
+        cycles = (f"; cycles per step (ideal) median {m['cycles_median']}, max {m['cycles_max']}"
+                  if "cycles_max" in m and "cycles_median" in m else "")
+        out.append(f"{m['controller']} ({m['mode']}, start {m['start']}): {m['golden_mismatch_steps']} steps differ "
+                   f"from the golden model; against the float64 law |Δ angle| ≤ {m['max_angle_diff_deg']:.2e}°, "
+                   f"|Δ torque| ≤ {m['max_torque_diff']:.2e} N·m, |Δ μ| ≤ {m['max_mu_diff']:.2e} N·m{cycles}.")
+    return out
+
+
 def _k1_bounds(m: dict) -> str:
     law = m.get("law")
     ok = isinstance(law, dict) and all(isinstance(law.get(k), (int, float)) for k in ("k1", "k1_bar"))
@@ -312,10 +332,9 @@ def _k1_bounds(m: dict) -> str:
 
 def _gp_fig7_reading(runs: list[dict]) -> list[str]:
     """GP runs from both starts: is the first minute's variance fraction (and K1) higher outside?"""
-    law = {m["start"]: m for m in runs if m["controller"] != "gp-baseline"}
-    if "capture" not in law or "outside" not in law:
+    cap, out = _gp_law_run(runs, "capture"), _gp_law_run(runs, "outside")
+    if cap is None or out is None:
         return []
-    cap, out = law["capture"], law["outside"]
     rises = (out["var_fraction_first_60s"] > cap["var_fraction_first_60s"]
              and out["gains_first_60s"][0] > cap["gains_first_60s"][0])
     return [f"{'holds' if rises else 'does not hold'} — first 60 s: variance fraction s {out['var_fraction_first_60s']:.3g} "
@@ -338,6 +357,7 @@ def gp_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
                       "(docs/gp-takeover.md §5, §12).")]
     out += [Block("p", f"Paper: {GP_CLAIMS['settle']}. Ours, {line}") for line in _gp_settle_reading(runs)]
     out += [Block("p", f"Paper: {GP_CLAIMS['fig7']}. Ours, {line}") for line in _gp_fig7_reading(runs)]
+    out += [Block("p", f"Generated C in the loop, {line}") for line in _gp_in_the_loop(runs)]
     captions = {"fig4_attitude.png": "attitude error angle and q_v (the paper's Fig. 4)",
                 "fig5_rates.png": "angular velocity (Fig. 5)", "fig6_torque.png": "torque and wheel momentum (Fig. 6)",
                 "fig7_variance_gains.png": "normalised variance and gains (Fig. 7)",
@@ -501,7 +521,7 @@ def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_d
         "rbf_figures": {f"{i + 1}_{name}": data for i, d in enumerate(rbf_dirs) for name in RBF_FIGURES
                         if (data := _read_figure(d / name)) is not None},
         "gp": [documents.read(d / "metrics.json", "GP takeover run (metrics.json)", documents.GP_RUN,
-                              "staregen simulate --controller gp-baseline|gp") for d in gp_dirs],
+                              "staregen simulate --controller gp-baseline|gp|gp-c|gp-arm") for d in gp_dirs],
         "gp_figures": {f"{i + 1}_{name}": data for i, d in enumerate(gp_dirs) for name in GP_FIGURES
                        if (data := _read_figure(d / name)) is not None},
         "tuning": documents.read(tune_dir / "result.json", "tuning result (result.json)", documents.TUNING,

@@ -89,7 +89,10 @@ GP_RUN = {
     "steady_error_deg_max": NONNEG, "torque_rms": ListOf(NONNEG, 3), "max_abs_torque": NONNEG,
     "h_w_end": XYZ, "t_momentum_limit": ListOf(Maybe(REAL), 3), "gains_first_60s": ListOf(REAL, 2),
     "gains_last_60s": ListOf(REAL, 2), "var_fraction_first_60s": Maybe(NONNEG), "var_fraction_last_60s": Maybe(NONNEG),
+    "mode?": TEXT, "golden_mismatch_steps?": COUNT, "max_angle_diff_deg?": NONNEG, "max_torque_diff?": NONNEG,
+    "max_mu_diff?": NONNEG, "cycles_median?": COUNT, "cycles_max?": COUNT,
 }
+GP_IN_LOOP = ("mode", "golden_mismatch_steps", "max_angle_diff_deg", "max_torque_diff", "max_mu_diff")  # all or none
 
 
 def _label(value) -> str:
@@ -199,9 +202,10 @@ def read(path: Path, what: str, shape, writer: str) -> dict:
             _check_frequency_grid(doc)
         if shape is CALIBRATION:
             _check_calibration_labels(doc)
-        if shape is RBF_RUN and 0 < sum(key in doc for key in RBF_IN_LOOP) < len(RBF_IN_LOOP):
-            missing = next(key for key in RBF_IN_LOOP if key not in doc)
-            raise HostError(f"{missing}: missing (a C-in-the-loop run has all of {', '.join(RBF_IN_LOOP)})")
+        group = RBF_IN_LOOP if shape is RBF_RUN else GP_IN_LOOP if shape is GP_RUN else ()
+        if 0 < sum(key in doc for key in group) < len(group):
+            missing = next(key for key in group if key not in doc)
+            raise HostError(f"{missing}: missing (a C-in-the-loop run has all of {', '.join(group)})")
     except HostError as exc:
         raise HostError(f"{path}: not written by `{writer}`: {exc}") from None
     return doc

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from codegen.units.gp.params import load_params
+from codegen.units.gp.records import INPUT_DTYPE, OUTPUT_DTYPE
 from host.control.takeover_laws import gp_law
 from host.core.constants import DEG
 from host.errors import HostError
@@ -35,26 +36,42 @@ def test_the_outside_start_is_60_degrees_about_the_capture_axis():
 
 
 def test_unknown_controller_is_one_line():
-    with pytest.raises(HostError, match="unknown controller 'gp-c'"):
-        gp_example.run("gp-c", None, 1.0)
+    with pytest.raises(HostError, match="unknown controller 'gp-x'"):
+        gp_example.run("gp-x", None, 1.0)
 
 
 def test_a_unit_step_on_records_flies_like_the_float64_law(params):
-    """The seam for gp-c / gp-arm: a step on the unit's records (float32 inputs) in the loop."""
+    """record_controller: a step on the unit's records (one float32 input record) in the loop."""
     law = gp_law(params)
     seen = []
 
     def step(record):
-        seen.append({k: v.dtype for k, v in record.items()})
-        out = law(record["q"].astype(float), record["omega"].astype(float), record["h_w"].astype(float))
-        return {"torque": out.torque.astype(np.float32), "mu": out.mu.astype(np.float32),
-                "var": out.var.astype(np.float32), "gains": out.gains.astype(np.float32), "status": 0}
+        seen.append(record.dtype)
+        r = record[0]
+        out = law(r["q"].astype(float), r["omega"].astype(float), r["h_w"].astype(float))
+        rec = np.zeros(1, dtype=OUTPUT_DTYPE)
+        rec["torque"], rec["mu"], rec["var"], rec["gains"] = out.torque, out.mu, out.var, out.gains
+        return rec
 
     unit = gp_example.fly(gp_example.record_controller(step), params, 5.0, "capture")
     ref = gp_example.fly(gp_example.controller_for("gp", params), params, 5.0, "capture")
-    assert seen[0] == {"q": np.float32, "omega": np.float32, "h_w": np.float32} and len(seen) == 50
+    assert seen[0] == INPUT_DTYPE and len(seen) == 50
     np.testing.assert_allclose(unit["angle"], ref["angle"], atol=1e-6 * DEG)
     np.testing.assert_allclose(unit["gains"][:-1], ref["gains"][:-1], rtol=1e-5)
+
+
+@pytest.mark.parametrize("controller, mode", [("gp-c", "SIL x86"), ("gp-arm", "PIL ARM emulator")])
+def test_the_generated_c_in_the_loop_flies_like_the_float64_law(params, controller, mode):
+    """SIL / PIL: no step differs from the golden twin, and the float32 C stays within float32 rounding of
+    the float64 law (attitude to 1e-4 deg, torque to 1e-4 N*m over 3 s from the capture state)."""
+    m = gp_example.run(controller, params, 3.0)["metrics"]
+    assert m["mode"] == mode and m["golden_mismatch_steps"] == 0
+    assert m["max_angle_diff_deg"] < 1e-4 and m["max_torque_diff"] < 1e-4 and m["max_mu_diff"] < 1e-4
+    assert m["max_angle_diff_deg"] > 0 or m["max_torque_diff"] > 0     # float32 against float64: not the same run
+    if controller == "gp-arm":
+        assert 0 < m["cycles_min"] <= m["cycles_max"] <= 15_000
+    else:
+        assert "cycles_max" not in m
 
 
 def test_window_metrics_against_hand_values():

@@ -251,5 +251,19 @@ def test_bad_gp_inputs_are_one_line(tmp_path, capsys):
     bad = _gp_run(tmp_path / "bad", start=3)
     assert main(["report", "--gp", str(bad), "--out", str(tmp_path / "r")]) == 2
     err = capsys.readouterr().err
-    assert "not written by `staregen simulate --controller gp-baseline|gp`" in err and "start" in err
+    assert "not written by `staregen simulate --controller gp-baseline|gp|gp-c|gp-arm`" in err and "start" in err
     assert err.count("\n") == 1 and not (tmp_path / "r").exists()
+    half = _gp_run(tmp_path / "half", controller="gp-c", golden_mismatch_steps=0)    # a C run without its comparison
+    assert main(["report", "--gp", str(half), "--out", str(tmp_path / "r")]) == 2
+    assert "mode: missing (a C-in-the-loop run has all of" in capsys.readouterr().err
+
+
+def test_the_gp_section_reports_the_generated_c_in_the_loop(tmp_path):
+    c_run = _gp_run(tmp_path / "c", controller="gp-arm", mode="PIL ARM emulator", golden_mismatch_steps=0,
+                    max_angle_diff_deg=3.5e-6, max_torque_diff=1.6e-5, max_mu_diff=1.2e-5, cycles_median=8613,
+                    cycles_max=8615)
+    assert main(["report", "--gp", str(_gp_run(tmp_path / "g")), "--gp", str(c_run), "--out", str(tmp_path / "r")]) == 0
+    md = (tmp_path / "r" / "report.md").read_text()
+    assert ("Generated C in the loop, gp-arm (PIL ARM emulator, start capture): 0 steps differ from the golden model; "
+            "against the float64 law \\|Δ angle\\| ≤ 3.50e-06°") in md
+    assert "cycles per step (ideal) median 8613, max 8615." in md
