@@ -22,7 +22,10 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+import gpytorch
 import numpy as np
+import torch
+from scipy.cluster.vq import kmeans2
 
 from codegen.units.gp import artifact as gpa
 
@@ -37,7 +40,6 @@ INIT_NOISE = 0.01
 
 
 def _torch():
-    import torch
     torch.set_num_threads(1)
     return torch
 
@@ -74,8 +76,6 @@ def mse(pred: np.ndarray, d: np.ndarray) -> dict:
 # ----------------------------------------------------------------------------- models
 
 def _exact_model_class():
-    import gpytorch
-
     class BatchExactGP(gpytorch.models.ExactGP):
         def __init__(self, tx, ty, likelihood):
             super().__init__(tx, ty, likelihood)
@@ -91,8 +91,6 @@ def _exact_model_class():
 
 
 def _sparse_model_class():
-    import gpytorch
-
     class SharedSVGP(gpytorch.models.ApproximateGP):
         def __init__(self, Z):
             vd = gpytorch.variational.CholeskyVariationalDistribution(Z.shape[0], batch_shape=(3,))
@@ -130,7 +128,6 @@ class GpFit:
 
     def predict(self, x, noise: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """Latent mean and variance (N×3 each) in raw units; noise=True adds the per-axis noise."""
-        import gpytorch
         torch = _torch()
         xn = torch.as_tensor(normalise_x(np.atleast_2d(x)), dtype=torch.float64)
         self.model.eval()
@@ -153,7 +150,6 @@ class GpFit:
 
 def train_exact(x, d, iterations: int = EXACT_ITERATIONS, lr: float = EXACT_LR, seed: int = 0) -> GpFit:
     """Batch of three exact GPs on the normalised data (§2, §4); time = construction + Adam loop."""
-    import gpytorch
     torch = _torch()
     x, d = check_data(x, d)
     s = output_scales(d)
@@ -184,7 +180,6 @@ def train_exact(x, d, iterations: int = EXACT_ITERATIONS, lr: float = EXACT_LR, 
 
 def kmeans_init(xn: np.ndarray, m: int) -> np.ndarray:
     """k-means++ centres of the normalised inputs (scipy kmeans2, minit="++", seed=0)."""
-    from scipy.cluster.vq import kmeans2
     centres, _ = kmeans2(xn, m, minit="++", seed=0)
     return centres
 
@@ -192,7 +187,6 @@ def kmeans_init(xn: np.ndarray, m: int) -> np.ndarray:
 def train_sparse(x, d, m: int = DEFAULT_M, iterations: int = SPARSE_ITERATIONS, lr: float = SPARSE_LR,
                  seed: int = 0) -> GpFit:
     """SVGP with shared Z and kernel, per-axis q(u) and noise (§2, §4), full-batch ELBO."""
-    import gpytorch
     torch = _torch()
     x, d = check_data(x, d)
     if not 1 <= m <= min(len(x), gpa.MAX_INDUCING):
@@ -231,7 +225,6 @@ def train_sparse(x, d, m: int = DEFAULT_M, iterations: int = SPARSE_ITERATIONS, 
 
 def flight_arrays(fit: GpFit) -> gpa.GpArrays:
     """The float64 model arrays of §6 from a trained SVGP (the flight float32 arrays derive from them)."""
-    import gpytorch
     if fit.kind != "sparse":
         raise ValueError("flight arrays come from a sparse GP")
     model = fit.model
@@ -257,8 +250,6 @@ def flight_arrays(fit: GpFit) -> gpa.GpArrays:
 
 def artifact_from(fit: GpFit, metadata: dict | None = None, cond_max: float = gpa.COND_MAX) -> gpa.GpArtifact:
     """The sealed GP artifact (§7) of a trained SVGP."""
-    import gpytorch
-    import torch
     meta = {"creator": "staregen host.learn.gp", "seed": fit.seed, "dataset_sha256": None, "test_mse": None,
             "train_time_s": round(fit.train_time_s, 3), "n_train": fit.n_train,
             "torch": torch.__version__, "gpytorch": gpytorch.__version__}

@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from scipy.linalg import solve_triangular
 
 from codegen import artifact as art
 from codegen import atomic
@@ -126,11 +127,7 @@ class GpArrays:
 
 
 def _solve_lower(L: np.ndarray, B: np.ndarray) -> np.ndarray:
-    try:
-        from scipy.linalg import solve_triangular
-        return solve_triangular(L, B, lower=True)
-    except ImportError:        # pragma: no cover
-        return np.linalg.solve(L, B)
+    return solve_triangular(L, B, lower=True)
 
 
 def reference_predict(a: GpArrays, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
