@@ -21,24 +21,20 @@ import time
 from pathlib import Path
 from typing import Callable
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from codegen import atomic  # noqa: E402
-from codegen.units.gp.params import GpLawParams  # noqa: E402
-from codegen.units.gp.records import INPUT_DTYPE  # noqa: E402
-from host.control.takeover_laws import LawOutput, baseline_law, gp_law, variance_fraction  # noqa: E402
-from host.core.constants import DEG  # noqa: E402
-from host.errors import HostError  # noqa: E402
-from host.plant.spacecraft import pack_state  # noqa: E402
-from host.plant.takeover import CAPTURE_AXIS, CAPTURE_RATE, TakeoverPlant, axis_angle_quat, capture_state  # noqa: E402
-from host.sim.plots import save_figure  # noqa: E402
-from host.sim.scenarios import configure_unit  # noqa: E402
-from host.sim.takeover import Controller, law_controller, metrics_of, simulate  # noqa: E402
-from tools.inloop import InTheLoop  # noqa: E402
+from codegen import atomic
+from codegen.units.gp.params import GpLawParams
+from codegen.units.gp.records import INPUT_DTYPE
+from host.control.takeover_laws import LawOutput, baseline_law, gp_law, variance_fraction
+from host.core.constants import DEG
+from host.errors import HostError
+from host.plant.spacecraft import pack_state
+from host.plant.takeover import CAPTURE_AXIS, CAPTURE_RATE, TakeoverPlant, axis_angle_quat, capture_state
+from host.sim.plots import stacked_figure as _figure
+from host.sim.scenarios import configure_unit
+from host.sim.takeover import Controller, law_controller, metrics_of, simulate
+from tools.inloop import InTheLoop
 
 CONTROLLERS = ("gp-baseline", "gp", "gp-c", "gp-arm")
 TARGETS = {"gp-c": "x86", "gp-arm": "arm"}
@@ -201,16 +197,6 @@ def write_outputs(out: Path, metrics: dict, hist: dict) -> None:
     if metrics["controller"] != "gp-baseline":
         _figure(out / "fig7_variance_gains.png", lambda axes: _variance_gains(axes, hist, metrics), 3)
         _figure(out / "fig_gp_mean.png", lambda axes: _gp_mean(axes, hist, metrics), 3)
-
-
-def _figure(path: Path, draw, rows: int) -> None:
-    fig, axes = plt.subplots(rows, 1, figsize=(8, 2.6 * rows + 0.8), sharex=True, squeeze=False)
-    draw(axes[:, 0])
-    for ax in axes[:, 0]:
-        ax.grid(True, alpha=0.3)
-    axes[-1, 0].set_xlabel("t (s)")
-    fig.tight_layout()
-    save_figure(fig, path)
 
 
 def _title(metrics: dict) -> str:

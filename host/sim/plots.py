@@ -23,6 +23,17 @@ def save_figure(fig, path: Path) -> Path:
     return Path(path)
 
 
+def stacked_figure(path: Path, draw, rows: int) -> Path:
+    """`rows` time plots stacked on one shared t axis, drawn by draw(axes), gridded and saved."""
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 2.6 * rows + 0.8), sharex=True, squeeze=False)
+    draw(axes[:, 0])
+    for ax in axes[:, 0]:
+        ax.grid(True, alpha=0.3)
+    axes[-1, 0].set_xlabel("t (s)")
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
 def _three_axis_plot(t, values, labels, ylabel, title, path) -> Path:
     fig, axes = plt.subplots(3, 1, figsize=(7.5, 6.5), sharex=True)
     for i, ax in enumerate(axes):

@@ -14,20 +14,16 @@ import time
 from pathlib import Path
 from types import SimpleNamespace
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from codegen import atomic  # noqa: E402
-from codegen.units.rbf.params import RbfParams  # noqa: E402
-from host.core.constants import DEG  # noqa: E402
-from host.errors import HostError  # noqa: E402
-from host.sim import rbf_tracking  # noqa: E402
-from host.sim.plots import save_figure  # noqa: E402
-from host.sim.scenarios import configure_unit  # noqa: E402
-from tools.inloop import InTheLoop  # noqa: E402
+from codegen import atomic
+from codegen.units.rbf.params import RbfParams
+from host.core.constants import DEG
+from host.errors import HostError
+from host.sim import rbf_tracking
+from host.sim.plots import stacked_figure as _figure
+from host.sim.scenarios import configure_unit
+from tools.inloop import InTheLoop
 
 CONTROLLERS = {"rbf": None, "rbf-c": "x86", "rbf-arm": "arm"}
 TARGET_NAMES = {"x86": "SIL x86", "arm": "PIL ARM emulator"}
@@ -121,16 +117,6 @@ def write_outputs(out: Path, metrics: dict, hist: dict, reference: dict | None) 
     _figure(out / "fig_commands.png", lambda axes: _commands(axes, hist), 2)
     if reference is not None:
         _figure(out / "fig_c_vs_float64.png", lambda axes: _c_vs_float64(axes, hist, reference, metrics), 1)
-
-
-def _figure(path: Path, draw, rows: int) -> None:
-    fig, axes = plt.subplots(rows, 1, figsize=(8, 2.6 * rows + 0.8), sharex=True, squeeze=False)
-    draw(axes[:, 0])
-    for ax in axes[:, 0]:
-        ax.grid(True, alpha=0.3)
-    axes[-1, 0].set_xlabel("t (s)")
-    fig.tight_layout()
-    save_figure(fig, path)
 
 
 def format_seconds(x) -> str:
