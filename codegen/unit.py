@@ -257,7 +257,8 @@ class UnitKind:
     with a CodegenError. `example()` gives small inputs for the tests written once for every
     unit (tests/codegen/units/test_every_unit.py): registering a unit is what gets it tested.
     `load_params(path)` reads and validates the unit's own parameter file (units that need
-    `params`); its errors are one-line CodegenErrors."""
+    `params`); its errors are one-line CodegenErrors. `takes_period`: the unit bakes a control
+    period into its C (`--period`, a package's period); False for a law that has none (gp)."""
 
     name: str
     summary: str
@@ -265,3 +266,4 @@ class UnitKind:
     configure: Callable[..., Unit]
     example: Callable[[], dict]
     load_params: Callable[[object], object] | None = None
+    takes_period: bool = True

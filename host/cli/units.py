@@ -54,7 +54,7 @@ def unit_from_args(args: argparse.Namespace) -> Unit:
         raise HostError(f"--name: {name_problem(args.name)} (got {show(args.name)})")
     inputs = {"name": args.name}
     if args.period is not None:
-        if "params" not in kind.needs:
+        if "params" not in kind.needs or not kind.takes_period:
             raise HostError(f"--period does not apply to unit {args.unit}")
         inputs["period"] = parse_number(args.period, "--period", positive=True)
     if args.params is not None:

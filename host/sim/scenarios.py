@@ -142,18 +142,18 @@ class Paper000ClosedLoop:
 def package_units(cfg: PackageConfig, artifact, params: dict | None = None) -> dict[str, Unit]:
     """The units of a flight package bound to its configuration: the controller `<name>` flying
     the network, and each other configured unit `<name>_<unit>` bound to its parameters
-    (`params[unit]`) at the same control period."""
+    (`params[unit]`) at the same control period (units that take one)."""
     params = dict(params or {})
-    units = {"controller": configure_unit("controller", artifact=artifact, config=cfg.controller, name=cfg.name)}
+    bound = {"controller": configure_unit("controller", artifact=artifact, config=cfg.controller, name=cfg.name)}
     for kind in cfg.param_units:
         if kind not in params:
             raise HostError(f"the configuration's units include \"{kind}\": give its parameter file with "
                             f"--params {kind}=FILE")
-        units[kind] = configure_unit(kind, params=params.pop(kind), period=cfg.controller.control_period,
-                                     name=f"{cfg.name}_{kind}")
+        period = cfg.controller.control_period if units.get(kind).takes_period else None
+        bound[kind] = configure_unit(kind, params=params.pop(kind), period=period, name=f"{cfg.name}_{kind}")
     for kind in params:
         raise HostError(f"--params {kind}=FILE given, but the configuration's [package] units do not include \"{kind}\"")
-    return units
+    return bound
 
 
 def unit_inputs(kind: str) -> dict:

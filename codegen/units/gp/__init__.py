@@ -9,4 +9,4 @@ from codegen.units.gp.unit import configure
 KIND = UnitKind(name="gp",
                 summary="paper 004's sparse-GP takeover law (GP mean and variance, scheduled gains; stateless)",
                 needs=("params",), configure=configure, example=lambda: {"params": example_params()},
-                load_params=load_params)
+                load_params=load_params, takes_period=False)

@@ -78,8 +78,8 @@ class GpUnit(Unit):
 
 
 def configure(params: GpLawParams | None = None, name: str | None = None, **_ignored) -> GpUnit:
-    """The unit bound to its law file (`--params docs/gp_paper004.toml`); a control period, if given
-    (a flight package passes its own), is not baked in: the law is stateless and static."""
+    """The unit bound to its law file (`--params docs/gp_paper004.toml`); the law is stateless and has no
+    control period (its KIND says `takes_period=False`: the CLI refuses `--period`)."""
     if params is None:
         raise CodegenError("unit gp needs --params FILE (the law file naming the GP artifact, e.g. docs/gp_paper004.toml)")
     if not isinstance(params, GpLawParams):
