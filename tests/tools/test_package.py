@@ -167,3 +167,5 @@ def test_package_with_the_gp_law(tmp_path):
     assert result.manifest["evidence"]["package_build"]["x86"]["selftest_mismatches"] == 0
     icd = (result.folder / "ICD.md").read_text()
     assert "## Unit `gp`: `stare_gp`" in icd and "STATUS_VAR_FLOOR" in icd and "(N*m)^2" in icd
+    assert "`stare_gp_step` has no period of its own and no state: call it once per control period" in icd
+    assert "None" not in icd
