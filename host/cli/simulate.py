@@ -56,7 +56,7 @@ def register(subparsers) -> None:
                    help="rbf and gp only: the law's parameter file (rbf: default docs/rbf_paper002.toml, theorem 2; "
                         "docs/rbf_paper002_theorem1.toml for theorem 1; gp: default docs/gp_paper004.toml, M = 20)")
     p.add_argument("--start", default=None, choices=gp_example.STARTS,
-                   help="gp-baseline and gp only: 'capture' (default, the post-capture state) or 'outside' "
+                   help="gp-baseline, gp, gp-c and gp-arm only: 'capture' (default, the post-capture state) or 'outside' "
                         "(60 deg off, outside the GP's training data: the paper's Fig. 7)")
     p.add_argument("--artifact", default=None, metavar="FILE",
                    help="model artifact for the network controllers (nn, nn-c, pid-c, nn-arm); "
@@ -269,7 +269,7 @@ def main(args: argparse.Namespace) -> int:
     if args.controller in rbf_example.CONTROLLERS:
         return run_rbf_example(args)
     if args.params is not None:
-        raise HostError("--params applies to --controller rbf, rbf-c, rbf-arm, gp-baseline, gp only")
+        raise HostError("--params applies to --controller rbf, rbf-c, rbf-arm, gp-baseline, gp, gp-c, gp-arm only")
     if args.controller in ("tanh", "tanh-c", "tanh-arm"):
         return run_tanh_example(args)
     if args.period is not None or args.dt is not None:

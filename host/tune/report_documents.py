@@ -93,6 +93,9 @@ GP_RUN = {
     "max_mu_diff?": NONNEG, "cycles_median?": COUNT, "cycles_max?": COUNT,
 }
 GP_IN_LOOP = ("mode", "golden_mismatch_steps", "max_angle_diff_deg", "max_torque_diff", "max_mu_diff")  # all or none
+# the names host.sim.gp_example writes (tests/host/tune/test_report.py checks they agree)
+GP_CONTROLLERS = ("gp-baseline", "gp", "gp-c", "gp-arm")
+GP_STARTS = ("capture", "outside")
 
 
 def _label(value) -> str:
@@ -178,6 +181,18 @@ def _check_calibration_labels(doc: dict) -> None:
                 raise HostError(f"{table}: no row for labels.{key} {_label(doc['labels'][key])}")
 
 
+def _check_gp_run(doc: dict) -> None:
+    """A known law and start; a GP law's run carries its variance fractions (the baseline's are null)."""
+    if doc["controller"] not in GP_CONTROLLERS:
+        raise HostError(f"controller: expected one of {', '.join(GP_CONTROLLERS)}, got {_label(doc['controller'])}")
+    if doc["start"] not in GP_STARTS:
+        raise HostError(f"start: expected one of {', '.join(GP_STARTS)}, got {_label(doc['start'])}")
+    if doc["controller"] != "gp-baseline":
+        for key in ("var_fraction_first_60s", "var_fraction_last_60s"):
+            if doc[key] is None:
+                raise HostError(f"{key}: a GP law's run must give it, got null")
+
+
 def _refuse_constant(name: str):
     raise ValueError(f"{name} is not JSON")
 
@@ -202,6 +217,8 @@ def read(path: Path, what: str, shape, writer: str) -> dict:
             _check_frequency_grid(doc)
         if shape is CALIBRATION:
             _check_calibration_labels(doc)
+        if shape is GP_RUN:
+            _check_gp_run(doc)
         group = RBF_IN_LOOP if shape is RBF_RUN else GP_IN_LOOP if shape is GP_RUN else ()
         if 0 < sum(key in doc for key in group) < len(group):
             missing = next(key for key in group if key not in doc)

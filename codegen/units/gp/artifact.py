@@ -171,6 +171,11 @@ class GpArtifact:
     envelope_max: np.ndarray
     cond_max: float = COND_MAX
     metadata: dict = field(default_factory=dict)
+    # A loaded artifact keeps the file's float32 flight arrays and conditioning record (checked against
+    # their re-derivation on load): the C and the seal then depend on the file only, not on the LAPACK
+    # of the machine that builds (a re-derivation may differ by 1 float32 ulp).
+    recorded_flight: dict | None = field(default=None, repr=False, compare=False)
+    recorded_conditioning: Conditioning | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self):
         validate(self)
@@ -181,7 +186,8 @@ class GpArtifact:
 
     @property
     def flight(self) -> dict[str, np.ndarray]:
-        return self.arrays.flight()
+        """The float32 arrays the flight C bakes in: the file's when loaded, else derived."""
+        return dict(self.recorded_flight) if self.recorded_flight is not None else self.arrays.flight()
 
     def payload(self) -> dict:
         return _payload_of(self)
@@ -213,7 +219,7 @@ def _h32(values) -> list:
 def _payload_of(g: GpArtifact) -> dict:
     a = g.arrays
     M = a.n_inducing
-    c = g.conditioning
+    c = g.recorded_conditioning or g.conditioning
     fl = g.flight
     return {
         "model": {"n_inducing": M, "n_out": N_OUT, "kernel": KERNEL,
@@ -396,8 +402,8 @@ def from_document(doc: Any, source: str | None = None) -> GpArtifact:
     }
     cond = r.real(co["cond"], "payload.conditioning.cond", False)
     cond_max = r.real(co["cond_max"], "payload.conditioning.cond_max", False)
-    r.real(co["min_eig"], "payload.conditioning.min_eig", False)
-    _real_list(r, co["s_max"], "payload.conditioning.s_max", N_OUT, False)
+    min_eig = r.real(co["min_eig"], "payload.conditioning.min_eig", False)
+    s_max = _real_list(r, co["s_max"], "payload.conditioning.s_max", N_OUT, False)
     try:
         g = GpArtifact(arrays=arrays,
                        envelope_min=_real_list(r, en["min"], "payload.envelope.min", N_IN, False),
@@ -415,7 +421,10 @@ def from_document(doc: Any, source: str | None = None) -> GpArtifact:
             r.fail(f"payload.flight.{name}", "differs by more than 1 float32 ulp from its re-derivation from "
                                              "the float64 fields")
     art.check_seal(r, doc)
-    return g
+    kept = {name: np.asarray(value, dtype=np.float32) for name, value in recorded.items()}
+    record = Conditioning(cond=cond, cond_max=cond_max, min_eig=min_eig, s_max=tuple(float(v) for v in s_max))
+    return GpArtifact(arrays=arrays, envelope_min=g.envelope_min, envelope_max=g.envelope_max, cond_max=cond_max,
+                      metadata=g.metadata, recorded_flight=kept, recorded_conditioning=record)
 
 
 def load(path: str | os.PathLike) -> GpArtifact:

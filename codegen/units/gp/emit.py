@@ -94,9 +94,20 @@ def check_magnitudes(fl: dict, m: int) -> None:
         e_max = w_max * float(R.sum(axis=0).max())
         if not e_max <= W_MAX:
             raise CodegenError(f"GP artifact: axis {k}: |R_k^T w| may reach {e_max:.3g}, above {W_MAX:g}")
-        mu_max = float(fl["mu_scale"][k]) * w_max * float(np.abs(fl["m"][k].astype(np.float64)).sum())
-        if not mu_max <= MEAN_MAX:
-            raise CodegenError(f"GP artifact: axis {k}: the mean may reach {mu_max:.3g} N*m, above {MEAN_MAX:g}")
+        sum_max = w_max * float(np.abs(fl["m"][k].astype(np.float64)).sum())     # m_k^T w, summed before scaling
+        mu_max = float(fl["mu_scale"][k]) * sum_max
+        if not (sum_max <= MEAN_MAX and mu_max <= MEAN_MAX):
+            raise CodegenError(f"GP artifact: axis {k}: the mean's sum may reach {sum_max:.3g} (scaled "
+                               f"{mu_max:.3g} N*m), above {MEAN_MAX:g}")
+
+
+def schedule_scale(kxx: np.float32, inv_kxx: np.float32) -> np.float32:
+    """1 / k_xx as the step multiplies by it: the artifact's value, lowered by an ulp while
+    fl(k_xx * it) > 1 (about 5 % of float32 values of k_xx), so that s = v / k_xx <= 1 for v <= k_xx."""
+    inv = np.float32(inv_kxx)
+    while np.float32(kxx * inv) > np.float32(1.0):
+        inv = np.nextafter(inv, np.float32(0.0))
+    return inv
 
 
 def constants32(p: GpLawParams) -> Constants32:
@@ -121,7 +132,8 @@ def constants32(p: GpLawParams) -> Constants32:
     return Constants32(
         m=m, g=fl["g"].astype(np.float32), zt=fl["zt"].astype(np.float32), c=fl["c"].astype(np.float32),
         a=fl["A"].astype(np.float32), rt=_column_packed(R).astype(np.float32),
-        mw=np.ascontiguousarray(fl["m"].astype(np.float32).T), kxx=kxx, inv_kxx=np.float32(fl["inv_kxx"]),
+        mw=np.ascontiguousarray(fl["m"].astype(np.float32).T), kxx=kxx,
+        inv_kxx=schedule_scale(kxx, np.float32(fl["inv_kxx"])),
         mu_scale=fl["mu_scale"].astype(np.float32), var_scale=var_scale, prior_var=prior_var,
         k1=k1, dk1=_c32(float(p.k1_bar) - float(p.k1), "k1_bar - k1", low=0.0), k1_bar=k1_bar,
         k2=k2, dk2=_c32(float(p.k2_bar) - float(p.k2), "k2_bar - k2", low=0.0), k2_bar=k2_bar, torque_max=_c32(p.torque_max, "torque_max"),

@@ -34,9 +34,12 @@ def in_box(k: Constants32, inp: np.ndarray) -> np.ndarray:
 
 
 def _exponent(k: Constants32, t: np.ndarray) -> np.ndarray:
-    """max(min(t, 0), -87) (the C's bit clamp: the same values for every t that is not NaN)."""
-    t = np.where(t >= k.box["exponent_min"], t, k.box["exponent_min"])
-    return np.where(t <= F32(0.0), t, F32(0.0)).astype(F32)
+    """The C's clamp to [-87, 0] on the bits: a clear sign bit -> +0, then the unsigned minimum with
+    -87's bits (max(min(t, 0), -87) for every t that is not NaN; a NaN maps as the C maps it)."""
+    u = np.ascontiguousarray(t, dtype=F32).view(U32)
+    u = u & (U32(0) - (u >> U32(31)))
+    u = np.minimum(u, np.float32(k.box["exponent_min"]).view(U32))
+    return u.view(F32)
 
 
 def projection(k: Constants32, x: list[np.ndarray]) -> list[np.ndarray]:

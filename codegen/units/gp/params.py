@@ -64,8 +64,8 @@ class GpLawParams:
 
     def law_mapping(self) -> dict:
         """The law's constants as the file writes them (without the artifact)."""
-        return {"k1": self.k1, "k1_bar": self.k1_bar, "k2": self.k2, "k2_bar": self.k2_bar,
-                "torque_max": self.torque_max, "inertia": [list(r) for r in self.inertia]}
+        return {"k1": float(self.k1), "k1_bar": float(self.k1_bar), "k2": float(self.k2), "k2_bar": float(self.k2_bar),
+                "torque_max": float(self.torque_max), "inertia": [[float(v) for v in r] for r in self.inertia]}
 
     def sha256(self) -> str:
         """sha256 of the law's constants and the artifact's seal (what the C bakes in)."""
@@ -113,12 +113,15 @@ def inertia_matrix(inertia) -> np.ndarray:
 
 
 def _artifact_path(value, folder: Path) -> Path:
+    """The artifact beside the law file or below its folder: a relative path without '..'."""
     if not isinstance(value, str) or not value:
         _fail("artifact", f"must be a file name (a string), got {values.show(value)}")
-    if len(value) > PATH_MAX or any(ord(ch) < 32 or ord(ch) == 127 for ch in value):
+    if len(value) > PATH_MAX or not value.isprintable():
         _fail("artifact", f"must be a path of at most {PATH_MAX} printable characters, got {values.show(value)}")
     path = Path(value)
-    return path if path.is_absolute() else folder / path
+    if path.is_absolute() or ".." in path.parts:
+        _fail("artifact", f"must be relative to the law file's folder, without '..', got {values.show(value)}")
+    return folder / path
 
 
 def load_params(path) -> GpLawParams:

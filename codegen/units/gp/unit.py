@@ -77,7 +77,7 @@ class GpUnit(Unit):
             f"{name} {int(((s & bit) != 0).sum())}" for bit, name in STATUS_NAMES)
 
 
-def configure(params: GpLawParams | None = None, name: str | None = None, **_ignored) -> GpUnit:
+def configure(params: GpLawParams | None = None, name: str | None = None) -> GpUnit:
     """The unit bound to its law file (`--params docs/gp_paper004.toml`); the law is stateless and has no
     control period (its KIND says `takes_period=False`: the CLI refuses `--period`)."""
     if params is None:

@@ -84,9 +84,11 @@ def _class_box(p: GpLawParams, rng, n):
     q = rows[:, :4].astype(np.float64)
     q *= np.sqrt(target / (q * q).sum(axis=1))[:, None]
     rows[qrows, :4] = q[qrows].astype(F32)
-    # a few: a component of q beyond 1.1
+    # a few: a component of q at +-1.1 exactly (inside the box, |q|^2 then decides) or one step beyond
     qbig = rng.random(n) < 0.1
-    rows[qbig, 0] = np.nextafter(F32(rec.Q_MAX), F32(np.inf))
+    edge = np.where(rng.random(n) < 0.5, F32(rec.Q_MAX), np.nextafter(F32(rec.Q_MAX), F32(np.inf)))
+    col_q = rng.integers(0, 4, n)
+    rows[qbig, col_q[qbig]] = (edge * rng.choice([-1.0, 1.0], n).astype(F32))[qbig]
     return np.ascontiguousarray(rows).view(rec.INPUT_DTYPE).reshape(n)
 
 
@@ -94,6 +96,9 @@ def _class_special(p: GpLawParams, rng, n):
     rows = _class_inside(p, rng, n).view(F32).reshape(n, N_FIELDS).copy()
     specials = np.array([np.nan, np.inf, -np.inf, -0.0, 1e-40, -1e-40, np.finfo(F32).max, -np.finfo(F32).max,
                          0.0, np.finfo(F32).tiny], dtype=F32)
+    # NaNs of both signs and with payloads (quiet and signalling patterns)
+    specials = np.concatenate([specials, np.array([0xFFC00000, 0x7FC00001, 0x7F800001, 0xFFBFFFFF],
+                                                  dtype=np.uint32).view(F32)])
     for _ in range(2):
         col = rng.integers(0, N_FIELDS, n)
         rows[np.arange(n), col] = specials[rng.integers(0, len(specials), n)]

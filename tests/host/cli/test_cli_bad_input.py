@@ -145,7 +145,7 @@ CASES = [
     (["simulate", "--controller", "rbf", "--params", "docs/tanh_paper000.toml", "--out", "{tmp}/s"],
      "unknown key 'beta1'"),
     (["simulate", "--controller", "pid", "--params", "docs/rbf_paper002.toml", "--out", "{tmp}/s"],
-     "--params applies to --controller rbf, rbf-c, rbf-arm, gp-baseline, gp only"),
+     "--params applies to --controller rbf, rbf-c, rbf-arm, gp-baseline, gp, gp-c, gp-arm only"),
     (["simulate", "--controller", "rbf-c", "--target", "all", "--out", "{tmp}/s"], "--target and --scenario do not apply"),
     (["simulate", "--controller", "rbf", "--period", "0", "--out", "{tmp}/s"], "--period"),
     (["simulate", "--controller", "rbf", "--dt", "0.5", "--out", "{tmp}/s"], "--dt"),

@@ -8,7 +8,9 @@ from html.parser import HTMLParser
 import numpy as np
 
 from host.cli import main
+from host.sim import gp_example
 from host.tune import figures
+from host.tune import report_documents as documents
 from host.tune.report import PAPER_TABLE9, _g
 
 
@@ -253,6 +255,10 @@ def test_bad_gp_inputs_are_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "not written by `staregen simulate --controller gp-baseline|gp|gp-c|gp-arm`" in err and "start" in err
     assert err.count("\n") == 1 and not (tmp_path / "r").exists()
+    for i, change in enumerate([{"controller": "gp-x"}, {"start": "far"}, {"var_fraction_first_60s": None}]):
+        odd = _gp_run(tmp_path / f"odd{i}", **change)
+        assert main(["report", "--gp", str(odd), "--out", str(tmp_path / "r")]) == 2
+        assert next(iter(change)) in capsys.readouterr().err
     half = _gp_run(tmp_path / "half", controller="gp-c", golden_mismatch_steps=0)    # a C run without its comparison
     assert main(["report", "--gp", str(half), "--out", str(tmp_path / "r")]) == 2
     assert "mode: missing (a C-in-the-loop run has all of" in capsys.readouterr().err
@@ -267,3 +273,7 @@ def test_the_gp_section_reports_the_generated_c_in_the_loop(tmp_path):
     assert ("Generated C in the loop, gp-arm (PIL ARM emulator, start capture): 0 steps differ from the golden model; "
             "against the float64 law \\|Δ angle\\| ≤ 3.50e-06°") in md
     assert "cycles per step (ideal) median 8613, max 8615." in md
+
+
+def test_the_report_knows_the_names_the_gp_runs_write():
+    assert documents.GP_CONTROLLERS == gp_example.CONTROLLERS and documents.GP_STARTS == gp_example.STARTS
