@@ -2,7 +2,7 @@
 
 A unit folder's `__init__.py` defines `KIND` (a codegen.unit.UnitKind); `kinds()` imports every
 folder here and collects them, so adding a unit is adding its folder. A folder under construction
-says so with `KIND = None` (e.g. `gp`, whose artifact exists before its unit) and is not registered;
+says so with `KIND = None` (as `gp` did while only its artifact existed) and is not registered;
 a folder without `KIND` is an error, not a silently missing unit. A unit that lives
 elsewhere (a user's own, or a test's throw-away one) calls `register(kind)` once.
 """
