@@ -4,6 +4,8 @@ law, the clamps, the invalid path, the parameter file and the emitter's refusals
 from __future__ import annotations
 
 import json
+import shutil
+import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +19,7 @@ from codegen.units.gp.emit import W_MAX, check_magnitudes, constants32, gp_sourc
 from codegen.units.gp.example import example_artifact, example_params
 from codegen.units.gp.params import GpLawParams, GpParamsError, load_params
 from codegen.units.gp.unit import GpUnit, configure
+from firmware.flags import COMMON
 from tools.gate import run_gate
 from tools.runners import X86Runner
 
@@ -284,3 +287,16 @@ def test_a_loaded_artifact_is_the_file_bit_for_bit():
     g = gpa.load(path)
     assert g.to_json() == path.read_text() and g.sha256 == json.loads(path.read_text())["sha256"]
     assert g.recorded_flight is not None and g.recorded_conditioning is not None
+
+
+@pytest.mark.parametrize("cc", ["gcc", "clang"])
+def test_gcc_and_clang_compile_the_unit_with_the_flight_flags(tmp_path, cc):
+    """SPEC section 5: the generated C builds with gcc and clang under -Werror (the trained M = 20 model)."""
+    if shutil.which(cc) is None:
+        pytest.fail(f"{cc} is not installed (make setup installs it)")
+    for name, text in gp_sources(load_params(DOCS / "gp_paper004.toml")).items():
+        (tmp_path / name).write_text(text)
+    flags = [f for f in COMMON if cc == "gcc" or f != "-fexcess-precision=standard"]
+    res = subprocess.run([cc, *flags, "-Wconversion", "-c", str(tmp_path / "gp.c"), "-o", str(tmp_path / "gp.o")],
+                         capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
