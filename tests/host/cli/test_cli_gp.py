@@ -5,6 +5,9 @@ from __future__ import annotations
 
 import hashlib
 import json
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -134,3 +137,10 @@ def test_train_refuses_m_above_the_pool_and_a_foreign_folder(tmp_path, capsys, m
     code, _, err = cli(capsys, "gp", "train", "--out", str(foreign))
     assert code == 2 and "not this command's own output" in err, err
     assert (foreign / "notes.txt").read_text() == "mine"
+
+
+def test_the_command_runs_as_a_module_too():
+    """`python3 -m host.cli` is the installed `staregen` (a checkout on PYTHONPATH, no pip install)."""
+    res = subprocess.run([sys.executable, "-m", "host.cli", "verify", "--unit", "gp", "--period", "0.1", "--params",
+                          "docs/gp_paper004.toml"], capture_output=True, text=True, cwd=Path(__file__).resolve().parents[3])
+    assert res.returncode == 2 and res.stderr.strip() == "staregen verify: error: --period does not apply to unit gp"
