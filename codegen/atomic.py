@@ -19,6 +19,8 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Iterator
 
+import numpy as np
+
 from codegen.errors import CodegenError
 
 LOCK_ATTEMPTS = 5   # a releasing run removes its lock file; reopen when it vanished under us
@@ -98,6 +100,14 @@ def writing(path: str | os.PathLike, suffix: str = "") -> Iterator[Path]:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_npz(path: str | os.PathLike, arrays: dict) -> Path:
+    """A compressed .npz of named arrays, written atomically."""
+    with writing(path, suffix=".npz") as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez_compressed(fh, **arrays)
+    return Path(path)
 
 
 class FolderInUse(CodegenError):

@@ -95,6 +95,15 @@ def check_dtype(dtype: np.dtype, what: str) -> np.dtype:
     return dtype
 
 
+def class_sizes(n: int, classes: tuple[str, ...], kind: str) -> list[int]:
+    """n gate vectors split evenly over the classes (the first takes the remainder); at least one each."""
+    if n < len(classes):
+        raise CodegenError(f"unit {kind}: need at least {len(classes)} vectors (one per class), got {n}")
+    sizes = [n // len(classes)] * len(classes)
+    sizes[0] += n - sum(sizes)
+    return sizes
+
+
 def records(dtype: np.dtype, n: int) -> np.ndarray:
     """n zeroed records of a unit dtype."""
     return np.zeros(n, dtype=dtype)

@@ -130,9 +130,7 @@ def format_table(r: CampaignResult) -> str:
 
 
 def _save_npz(path: Path, arrays: dict) -> None:
-    with atomic.writing(path, suffix=".npz") as tmp:
-        with open(tmp, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
+    atomic.write_npz(path, arrays)
 
 
 def write_campaign(r: CampaignResult, out: Path, scenario: dict | None = None) -> None:

@@ -188,9 +188,7 @@ def in_the_loop_metrics(loop: InTheLoop, hist: dict, reference: dict) -> dict:
 
 def write_outputs(out: Path, metrics: dict, hist: dict) -> None:
     atomic.write_json(out / "metrics.json", metrics)
-    with atomic.writing(out / "history.npz", suffix=".npz") as tmp:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(f, **{k: hist[k] for k in HISTORY_KEYS})
+    atomic.write_npz(out / "history.npz", {k: hist[k] for k in HISTORY_KEYS})
     _figure(out / "fig4_attitude.png", lambda axes: _attitude(axes, hist, metrics), 2)
     _figure(out / "fig5_rates.png", lambda axes: _rates(axes, hist, metrics), 1)
     _figure(out / "fig6_torque.png", lambda axes: _torque(axes, hist, metrics), 2)

@@ -108,9 +108,7 @@ def run(controller: str, params: RbfParams, duration: float = 1000.0, period: fl
 
 def write_outputs(out: Path, metrics: dict, hist: dict, reference: dict | None) -> None:
     atomic.write_json(out / "metrics.json", metrics)
-    with atomic.writing(out / "history.npz", suffix=".npz") as tmp:
-        with open(tmp, "wb") as f:
-            np.savez_compressed(f, **{k: hist[k] for k in HISTORY_KEYS})
+    atomic.write_npz(out / "history.npz", {k: hist[k] for k in HISTORY_KEYS})
     _figure(out / "fig_range_los.png", lambda axes: _range_los(axes, hist, metrics), 2)
     _figure(out / "fig_attitude.png", lambda axes: _attitude(axes, hist, metrics), 2)
     _figure(out / "fig_rbf_estimate.png", lambda axes: _estimate(axes, hist), 3)

@@ -12,8 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from codegen.errors import CodegenError
-from codegen.unit import Batch
+from codegen.unit import Batch, class_sizes
 from codegen.units.gp import records as rec
 from codegen.units.gp.params import GpLawParams
 
@@ -111,9 +110,6 @@ _MAKERS = {"inside": _class_inside, "inducing": _class_inducing, "edges": _class
 
 def gate_classes(p: GpLawParams, n: int, seed: int = 0) -> dict[str, Batch]:
     """n independent input rows in the six classes (deterministic in seed)."""
-    if n < len(CLASSES):
-        raise CodegenError(f"unit gp: need at least {len(CLASSES)} vectors (one per class), got {n}")
+    sizes = class_sizes(n, CLASSES, "gp")
     rng = np.random.default_rng(seed)
-    sizes = [n // len(CLASSES)] * len(CLASSES)
-    sizes[0] += n - sum(sizes)
     return {name: Batch(None, _MAKERS[name](p, rng, m)) for name, m in zip(CLASSES, sizes)}

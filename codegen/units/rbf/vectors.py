@@ -19,8 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from codegen.errors import CodegenError
-from codegen.unit import Batch
+from codegen.unit import Batch, class_sizes
 from codegen.units.rbf import records as rec
 from codegen.units.rbf.emit import BOX, Constants32
 
@@ -261,11 +260,8 @@ _MAKERS = {"inside": _class_inside, "edges": _class_edges, "outside": _class_out
 
 def gate_classes(k: Constants32, n: int, seed: int = 0) -> dict[str, Batch]:
     """n independent (state, input) rows in the six classes (deterministic in seed)."""
-    if n < len(CLASSES):
-        raise CodegenError(f"unit rbf: need at least {len(CLASSES)} vectors (one per class), got {n}")
+    sizes = class_sizes(n, CLASSES, "rbf")
     rng = np.random.default_rng(seed)
-    sizes = [n // len(CLASSES)] * len(CLASSES)
-    sizes[0] += n - sum(sizes)
     sdt = rec.state_dtype(k.nodes)
     out = {}
     for name, m in zip(CLASSES, sizes):

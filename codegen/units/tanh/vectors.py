@@ -18,8 +18,7 @@ from typing import Protocol
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from codegen.errors import CodegenError
-from codegen.unit import Batch
+from codegen.unit import Batch, class_sizes
 from codegen.units.tanh import golden as gt
 from codegen.units.tanh.emit import INPUT_DTYPE, STATE_DTYPE, Constants32
 
@@ -135,11 +134,8 @@ _MAKERS = {"random": _class_random, "small": _class_small, "delta": _class_delta
 
 def gate_classes(k: Constants32, n: int, seed: int = 0) -> dict[str, Batch]:
     """n independent (state, input) rows in the seven classes (deterministic in seed)."""
-    if n < len(CLASSES):
-        raise CodegenError(f"unit tanh: need at least {len(CLASSES)} vectors (one per class), got {n}")
+    sizes = class_sizes(n, CLASSES, "tanh")
     rng = np.random.default_rng(seed)
-    sizes = [n // len(CLASSES)] * len(CLASSES)
-    sizes[0] += n - sum(sizes)
     out = {}
     for name, m in zip(CLASSES, sizes):
         state, x = _MAKERS[name](k, rng, m)
