@@ -58,6 +58,17 @@ def environment(unit_templates: Path) -> jinja2.Environment:
     )
 
 
+def unit_sources(templates: Path, stem: str, name: str, ctx: dict, with_math: bool = True) -> dict[str, str]:
+    """`<name>.h` and `<name>.c` rendered from the unit's `<stem>.h.j2` / `<stem>.c.j2`, and (by
+    default) the math library beside them."""
+    env = environment(templates)
+    sources = {f"{name}.h": env.get_template(f"{stem}.h.j2").render(ctx),
+               f"{name}.c": env.get_template(f"{stem}.c.j2").render(ctx)}
+    if with_math:
+        sources.update(math_sources())
+    return sources
+
+
 def math_sources() -> dict[str, str]:
     """The deterministic math library (codegen/csrc), copied verbatim next to a unit."""
     sources = {}

@@ -15,7 +15,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION
 from codegen.units.controller import spec as cs
 from codegen.artifact import Artifact
-from codegen.cgen import c_float, check_name, comment, environment
+from codegen.cgen import c_float, check_name, comment, unit_sources
 from codegen.units.network.emit import network_sources
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -161,8 +161,6 @@ def controller_sources(a: Artifact, cfg: cs.ControllerConfig, name: str = DEFAUL
     check_name(name)
     if a.sizes[0] != 12 or a.sizes[2] != 3:
         raise ValueError(f"the controller needs a 12-input, 3-output network, got {a.shape_text}")
-    env, ctx = environment(TEMPLATES), controller_context(a, cfg, name)
     sources = network_sources(a, net_name(name))
-    sources[f"{name}.h"] = env.get_template("controller.h.j2").render(ctx)
-    sources[f"{name}.c"] = env.get_template("controller.c.j2").render(ctx)
+    sources.update(unit_sources(TEMPLATES, "controller", name, controller_context(a, cfg, name), with_math=False))
     return sources

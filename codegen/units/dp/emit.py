@@ -10,7 +10,7 @@ import numpy as np
 
 from codegen import GENERATOR_VERSION
 from codegen.artifact import TABLE2_NAMES, TABLE2_UNITS
-from codegen.cgen import c_float, check_name, comment, environment, math_sources
+from codegen.cgen import c_float, check_name, comment, unit_sources
 from codegen.units.dp.golden import Constants
 from codegen.units.dp.tables import DpTables, stack_estimate
 
@@ -113,8 +113,4 @@ def template_context(t: DpTables, name: str) -> dict:
 def dp_sources(t: DpTables, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text} of the generated step and the math library it calls."""
     check_name(name)
-    env, ctx = environment(TEMPLATES), template_context(t, name)
-    sources = {f"{name}.h": env.get_template("dp.h.j2").render(ctx),
-               f"{name}.c": env.get_template("dp.c.j2").render(ctx)}
-    sources.update(math_sources())
-    return sources
+    return unit_sources(TEMPLATES, "dp", name, template_context(t, name))

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import GENERATOR_VERSION
-from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
+from codegen.cgen import c_float, check_name, unit_sources, write_sources
 from codegen.errors import CodegenError
 from codegen.units.gp import records
 from codegen.units.gp.params import GpLawParams
@@ -180,11 +180,7 @@ def template_context(p: GpLawParams, name: str) -> dict:
 def gp_sources(p: GpLawParams, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text}: `<name>.h`, `<name>.c` and the sg_math library they use."""
     check_name(name)
-    env, ctx = environment(TEMPLATES), template_context(p, name)
-    sources = {f"{name}.h": env.get_template("gp.h.j2").render(ctx),
-               f"{name}.c": env.get_template("gp.c.j2").render(ctx)}
-    sources.update(math_sources())
-    return sources
+    return unit_sources(TEMPLATES, "gp", name, template_context(p, name))
 
 
 def emit_gp(p: GpLawParams, out_dir: str | os.PathLike, name: str = DEFAULT_NAME) -> list[Path]:

@@ -14,7 +14,7 @@ import numpy as np
 from codegen import GENERATOR_VERSION
 from codegen.detmath import TANH_COLS, TANH_HALF, tanh_rows
 from codegen.artifact import Artifact
-from codegen.cgen import c_float, check_name, comment, environment, math_sources, write_sources
+from codegen.cgen import c_float, check_name, comment, unit_sources, write_sources
 from codegen.units.network.fold import Folded, fold
 
 TEMPLATES = Path(__file__).with_name("templates")
@@ -127,13 +127,7 @@ def template_context(a: Artifact, name: str) -> dict:
 def network_sources(a: Artifact, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text} of the generated network path and the math library it calls."""
     check_name(name)
-    env, ctx = environment(TEMPLATES), template_context(a, name)
-    sources = {
-        f"{name}.h": env.get_template("network.h.j2").render(ctx),
-        f"{name}.c": env.get_template("network.c.j2").render(ctx),
-    }
-    sources.update(math_sources())
-    return sources
+    return unit_sources(TEMPLATES, "network", name, template_context(a, name))
 
 
 def emit(a: Artifact, out_dir: str | os.PathLike, name: str = DEFAULT_NAME) -> list[Path]:

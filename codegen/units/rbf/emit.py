@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import GENERATOR_VERSION, detmath
-from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
+from codegen.cgen import c_float, check_name, unit_sources, write_sources
 from codegen.errors import CodegenError
 from codegen.units.rbf import records
 from codegen.units.rbf.params import ANGLE_MAX, RbfParams
@@ -194,13 +194,7 @@ def template_context(p: RbfParams, period: float, name: str) -> dict:
 def rbf_sources(p: RbfParams, period: float = DEFAULT_PERIOD, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text}: `<name>.h`, `<name>.c` and the sg_math library they call."""
     check_name(name)
-    env, ctx = environment(TEMPLATES), template_context(p, period, name)
-    sources = {
-        f"{name}.h": env.get_template("rbf.h.j2").render(ctx),
-        f"{name}.c": env.get_template("rbf.c.j2").render(ctx),
-    }
-    sources.update(math_sources())
-    return sources
+    return unit_sources(TEMPLATES, "rbf", name, template_context(p, period, name))
 
 
 def emit_rbf(p: RbfParams, out_dir: str | os.PathLike, period: float = DEFAULT_PERIOD,

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from codegen import GENERATOR_VERSION, detmath
-from codegen.cgen import c_float, check_name, environment, math_sources, write_sources
+from codegen.cgen import c_float, check_name, unit_sources, write_sources
 from codegen.errors import CodegenError
 from codegen.values import float32_in
 from codegen.detmath import TANH_COLS, TANH_HALF, tanh_rows
@@ -193,13 +193,7 @@ def template_context(p: TanhParams, period: float, name: str) -> dict:
 def tanh_sources(p: TanhParams, period: float = DEFAULT_PERIOD, name: str = DEFAULT_NAME) -> dict[str, str]:
     """{file name: text}: `<name>.h`, `<name>.c` and the sg_math library they call."""
     check_name(name)
-    env, ctx = environment(TEMPLATES), template_context(p, period, name)
-    sources = {
-        f"{name}.h": env.get_template("tanh.h.j2").render(ctx),
-        f"{name}.c": env.get_template("tanh.c.j2").render(ctx),
-    }
-    sources.update(math_sources())
-    return sources
+    return unit_sources(TEMPLATES, "tanh", name, template_context(p, period, name))
 
 
 def emit_tanh(p: TanhParams, out_dir: str | os.PathLike, period: float = DEFAULT_PERIOD,
