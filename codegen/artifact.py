@@ -23,7 +23,7 @@ import numpy as np
 
 from codegen.errors import CodegenError
 from codegen import atomic, reading
-from codegen.values import DIGITS_TEXT
+from codegen.values import DIGITS_TEXT, show
 
 FORMAT = "staregen.mlp-artifact"
 VERSION = 1
@@ -757,15 +757,21 @@ def _read_outputs(r: DocumentReader, value, n_out: int) -> OutputSpec:
     return OutputSpec(*(r.strings(o[k], f"payload.outputs.{k}", n_out) for k in ("names", "units", "descriptions")))
 
 
+def read_envelope(r: DocumentReader, doc: Any, fmt: str, version: int, payload_keys: tuple[str, ...]) -> dict:
+    """The sealed document's envelope (format, version, sha256, payload) checked; returns the payload
+    object with exactly payload_keys (the seal itself is checked last, by check_seal)."""
+    r.obj(doc, "", ("format", "version", "sha256", "payload"))
+    if doc["format"] != fmt:
+        r.fail("format", f"expected {fmt!r}, got {show(doc['format'], 60)}")
+    if type(doc["version"]) is not int or doc["version"] != version:
+        r.fail("version", f"unsupported artifact version {show(doc['version'], 20)} (this staregen reads version {version})")
+    return r.obj(doc["payload"], "payload", payload_keys)
+
+
 def from_document(doc: Any, source: str | None = None) -> Artifact:
     """Validate a parsed JSON document and build the Artifact; the sha256 seal is checked last."""
     r = DocumentReader(source)
-    r.obj(doc, "", ("format", "version", "sha256", "payload"))
-    if doc["format"] != FORMAT:
-        r.fail("format", f"expected {FORMAT!r}, got {doc['format']!r}")
-    if type(doc["version"]) is not int or doc["version"] != VERSION:
-        r.fail("version", f"unsupported artifact version {doc['version']!r} (this staregen reads version {VERSION})")
-    payload = r.obj(doc["payload"], "payload", ("network", "normalisation", "envelope", "outputs", "metadata"))
+    payload = read_envelope(r, doc, FORMAT, VERSION, ("network", "normalisation", "envelope", "outputs", "metadata"))
     network = r.obj(payload["network"], NETWORK, ("sizes", "activations", "layers"))
     n_in, n_hidden, n_out = _read_sizes(r, network)
     layers = r.list(network["layers"], f"{NETWORK}.layers", 2)

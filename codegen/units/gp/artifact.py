@@ -338,13 +338,8 @@ def _ulp_close(recorded: np.ndarray, derived: np.ndarray) -> bool:
 def from_document(doc: Any, source: str | None = None) -> GpArtifact:
     """Validate a parsed JSON document and build the GpArtifact; the sha256 seal is checked last."""
     r = _R(source)
-    r.obj(doc, "", ("format", "version", "sha256", "payload"))
-    if doc["format"] != FORMAT:
-        r.fail("format", f"expected {FORMAT!r}, got {str(doc['format'])[:60]!r}")
-    if type(doc["version"]) is not int or doc["version"] != VERSION:
-        r.fail("version", f"unsupported artifact version {str(doc['version'])[:20]!r} (this staregen reads version {VERSION})")
-    p = r.obj(doc["payload"], "payload", ("model", "scales", "hyper", "inducing", "variational", "flight",
-                                          "conditioning", "envelope", "metadata"))
+    p = art.read_envelope(r, doc, FORMAT, VERSION, ("model", "scales", "hyper", "inducing", "variational", "flight",
+                                                    "conditioning", "envelope", "metadata"))
     model = r.obj(p["model"], "payload.model", ("n_inducing", "n_out", "kernel", "train_inputs", "flight_inputs",
                                                 "fixed_inputs"))
     M = model["n_inducing"]
