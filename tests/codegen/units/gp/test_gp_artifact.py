@@ -158,23 +158,24 @@ def test_construction_validates():
         make(R=np.zeros((3, M, M)))
 
 
-def test_a_unit_folder_under_construction_is_skipped(tmp_path, monkeypatch):
-    """`KIND = None` keeps a folder out of the registry (a unit whose artifact exists before its C)."""
-    (tmp_path / "wip").mkdir()
-    (tmp_path / "wip" / "__init__.py").write_text('"""Under construction."""\nKIND = None\n')
+def plant_unit_folder(tmp_path, monkeypatch, name: str, init_text: str) -> None:
+    """A unit folder `name` with the given __init__.py beside codegen/units, the registry reset."""
+    (tmp_path / name).mkdir()
+    (tmp_path / name / "__init__.py").write_text(init_text)
     monkeypatch.setattr(units, "__path__", [*units.__path__, str(tmp_path)])
     monkeypatch.setattr(units, "_discovered", False)
     monkeypatch.setattr(units, "_registered", {})
+
+
+def test_a_unit_folder_under_construction_is_skipped(tmp_path, monkeypatch):
+    """`KIND = None` keeps a folder out of the registry (a unit whose artifact exists before its C)."""
+    plant_unit_folder(tmp_path, monkeypatch, "wip", '"""Under construction."""\nKIND = None\n')
     known = units.kinds()
     assert "wip" not in known and {"gp", "rbf"} <= set(known)
 
 
 def test_a_unit_folder_without_kind_is_an_error(tmp_path, monkeypatch):
     """A folder that forgets KIND must not vanish from the registry silently."""
-    (tmp_path / "nokind").mkdir()
-    (tmp_path / "nokind" / "__init__.py").write_text('"""A unit folder that forgot its KIND."""\n')
-    monkeypatch.setattr(units, "__path__", [*units.__path__, str(tmp_path)])
-    monkeypatch.setattr(units, "_discovered", False)
-    monkeypatch.setattr(units, "_registered", {})
+    plant_unit_folder(tmp_path, monkeypatch, "nokind", '"""A unit folder that forgot its KIND."""\n')
     with pytest.raises(CodegenError, match="codegen/units/nokind: defines no KIND"):
         units.kinds()
