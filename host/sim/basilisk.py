@@ -1,0 +1,256 @@
+"""Basilisk (AVS Lab, `bsk`, the optional extra `basilisk`) flying the flight package: the staring
+scenario and paper 000's example built in an independent simulator. This is the only module that
+imports Basilisk; it does so when a run starts (the import takes seconds, and the extra is optional),
+and a missing extra is one line.
+
+Staring scenario (docs/basilisk.md gives the mapping and the differences measured):
+* hub: Table 6 mass and inertia. Basilisk's balanced wheels add only Js·g·gᵀ to the spin axes
+  (their back-substitution removes it again), so the hub gets I + Σ Js·g·gᵀ: with the wheels'
+  absolute momentum h = Js(Ω + gᵀω) this is exactly staregen's eq. 4 with I and h_w (u_s = −M_c);
+* orbit: Table 5's initial state, Earth as a point mass with staregen's μ (two-body, as staregen);
+* three orthogonal wheels: u_max = the torque limit, Ω_max·Js = the momentum limit, Js = h_max /
+  Ω_max at 6000 rpm, no friction; started with Ω = −gᵀω₀ (h_w = 0, Table 6);
+* gravity gradient: Basilisk's GravityGradientEffector (switchable); staregen's aerodynamic, solar
+  and magnetic models have no ephemeris-free Basilisk counterpart here and are off on both sides of
+  the cross-check;
+* one dynamics task at staregen's plant step (RK4, Basilisk's default integrator). The models run
+  in priority order: the spacecraft integrates to t_j and publishes, the flight module reads that
+  state and (at each control instant) steps the package's C, then the wheel effector reads the
+  command: a zero-order hold without delay, as in staregen.
+* errors: the scenario's error model and the very noise draws of staregen's simulator (same seed,
+  same stream): star sensor and gyro at the control instants, wheel bias and noise at every plant
+  step, so a difference between the two simulators is a difference of the plant, not of the dice.
+"""
+from __future__ import annotations
+
+import importlib
+from importlib import metadata
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Callable
+
+import numpy as np
+
+from host.control.controllers import Controller, Measurement
+from host.core.constants import MU_EARTH
+from host.core.rotations import euler312_from_dcm, quat_from_dcm
+from host.core.timebase import add_seconds
+from host.core.vec3 import dcm_from_quat3
+from host.errors import HostError
+from host.plant import orbit
+from host.plant.environment import EnvironmentTrack, L_oi
+from host.plant.sensors import measure
+from host.plant.spacecraft import saturate_torque
+from host.sim.simulator import SCENARIO_EPOCH, History, SimConfig, environment_track, initial_state, run_noise, \
+    true_errors
+
+BSK_VERSION = "2.12.1"
+INSTALL_HINT = "pip install -e '.[basilisk]'"
+WHEEL_MAX_RPM = 6000.0
+_PRIORITY = {"spacecraft": 300, "flight": 200, "wheels": 100, "recorders": 50}
+_MODULES = {"messaging": "Basilisk.architecture.messaging", "sysModel": "Basilisk.architecture.sysModel",
+            "spacecraft": "Basilisk.simulation.spacecraft",
+            "rw": "Basilisk.simulation.reactionWheelStateEffector",
+            "gg": "Basilisk.simulation.GravityGradientEffector", "ext": "Basilisk.simulation.extForceTorque",
+            "base": "Basilisk.utilities.SimulationBaseClass", "macros": "Basilisk.utilities.macros",
+            "grav": "Basilisk.utilities.simIncludeGravBody", "rwf": "Basilisk.utilities.simIncludeRW",
+            "rbk": "Basilisk.utilities.RigidBodyKinematics", "helpers": "Basilisk.utilities.simHelpers"}
+_loaded: SimpleNamespace | None = None
+
+
+def basilisk() -> SimpleNamespace:
+    """Basilisk's modules (imported once); HostError in one line when the extra is missing."""
+    global _loaded
+    if _loaded is None:
+        try:
+            version = metadata.version("bsk")
+            mods = {k: importlib.import_module(v) for k, v in _MODULES.items()}
+        except Exception:   # PackageNotFoundError, ImportError, or a broken install
+            raise HostError(f"Basilisk is not installed (the optional extra `basilisk`: {INSTALL_HINT})") from None
+        if version != BSK_VERSION:
+            raise HostError(f"Basilisk {version} is installed; staregen is checked against bsk=={BSK_VERSION} "
+                            f"({INSTALL_HINT})")
+        _loaded = SimpleNamespace(**mods)
+    return _loaded
+
+
+def _nanos(seconds: float) -> int:
+    return int(round(seconds * 1e9))
+
+
+@dataclass(frozen=True)
+class BasiliskOptions:
+    gravity_gradient: bool = True
+
+
+# ----------------------------------------------------------------------------- the flight module
+
+def _module_class(bsk: SimpleNamespace):
+    """A Python SysModel that calls `drive(j, sc_state) -> body torque` every dynamics step and
+    writes the wheels' motor torques (u_s = −M, wheels along the body axes) or a body torque."""
+
+    class FlightModule(bsk.sysModel.SysModel):
+        def __init__(self, drive: Callable, wheels: bool):
+            super().__init__()
+            self.drive, self.wheels, self.j = drive, wheels, 0
+            self.scStateInMsg = bsk.messaging.SCStatesMsgReader()
+            self.rwMotorTorqueOutMsg = bsk.messaging.ArrayMotorTorqueMsg()
+            self.cmdTorqueOutMsg = bsk.messaging.CmdTorqueBodyMsg()
+
+        def Reset(self, CurrentSimNanos):   # noqa: N802, N803 (Basilisk's names)
+            self.j = 0
+
+        def UpdateState(self, CurrentSimNanos):   # noqa: N802, N803
+            torque = self.drive(self.j, self.scStateInMsg())
+            self.j += 1
+            if self.wheels:
+                payload = bsk.messaging.ArrayMotorTorqueMsgPayload()
+                payload.motorTorque = [-float(x) for x in torque]
+                self.rwMotorTorqueOutMsg.write(payload, CurrentSimNanos, self.moduleID)
+            else:
+                payload = bsk.messaging.CmdTorqueBodyMsgPayload()
+                payload.torqueRequestBody = [float(x) for x in torque]
+                self.cmdTorqueOutMsg.write(payload, CurrentSimNanos, self.moduleID)
+
+    return FlightModule
+
+
+# ----------------------------------------------------------------------------- staring scenario
+
+class _StaringDrive:
+    """What the flight computer and the wheels' drive electronics do each dynamics step j: at the
+    control instants, sense (scenario errors) and step the controller; at every step, the wheels'
+    torque = saturated command + bias + noise (staregen's wheel model)."""
+
+    def __init__(self, controller: Controller, lon: float, lat: float, cfg: SimConfig, stream: int, n: int):
+        self.controller, self.lon, self.lat, self.cfg = controller, lon, lat, cfg
+        self.noise = run_noise(cfg, cfg.seed, stream)
+        self.sub = cfg.substeps
+        self.cmd = np.zeros(3)
+        self.rec_cmd, self.rec_applied = np.zeros((n + 1, 3)), np.zeros((n + 1, 3))
+        self.mode = np.empty(n + 1, dtype=object)
+
+    def measurement(self, j: int, st, bsk) -> Measurement:
+        t = j * self.cfg.plant_step
+        jd, sec = add_seconds(*SCENARIO_EPOCH, t)
+        R, V = np.array(st.r_BN_N, float), np.array(st.v_BN_N, float)
+        L_bi = np.array(bsk.rbk.MRP2C(np.array(st.sigma_BN, float)), float)
+        k = j // self.sub
+        A_bo = measure(euler312_from_dcm(L_bi @ L_oi(R, V).T), self.cfg.errors.star, self.noise.star[k],
+                       self.cfg.sensor_errors)
+        w = measure(np.array(st.omega_BN_B, float), self.cfg.errors.gyro, self.noise.gyro[k], self.cfg.sensor_errors)
+        return Measurement(t=t, jd_days=int(jd), sec_of_day=float(sec), A_bo=A_bo, omega_b=w, R_s=R, V_s=V,
+                           lon=self.lon, lat=self.lat)
+
+    def __call__(self, j: int, st) -> np.ndarray:
+        bsk = basilisk()
+        if j % self.sub == 0 and j < len(self.mode) - 1:
+            out = self.controller.step(self.measurement(j, st, bsk))
+            self.cmd = np.asarray(out.torque, float)
+            self.mode[j:j + self.sub] = out.mode
+        applied = saturate_torque(self.cmd, self.cfg.spacecraft.torque_limit)
+        if self.cfg.wheel_errors and j < len(self.mode) - 1:
+            applied = (applied + self.cfg.errors.wheels.bias_array) + self.noise.wheels[j]
+        self.rec_cmd[j], self.rec_applied[j] = self.cmd, applied
+        return applied
+
+
+def _wheel_inertia(cfg: SimConfig) -> float:
+    return cfg.spacecraft.momentum_limit / (WHEEL_MAX_RPM * 2.0 * np.pi / 60.0)
+
+
+def _add_wheels(bsk, sim, task: str, sc, cfg: SimConfig, omega0: np.ndarray):
+    factory = bsk.rwf.rwFactory()
+    for i in range(3):
+        axis = [0.0, 0.0, 0.0]
+        axis[i] = 1.0
+        factory.create("custom", axis, Omega=float(-omega0[i] * 60.0 / (2.0 * np.pi)), Omega_max=WHEEL_MAX_RPM,
+                       maxMomentum=float(cfg.spacecraft.momentum_limit), u_max=float(cfg.spacecraft.torque_limit),
+                       RWModel=bsk.messaging.BalancedWheels, useRWfriction=False, useMinTorque=False,
+                       useMaxTorque=True)
+    rw = bsk.rw.ReactionWheelStateEffector()
+    rw.ModelTag = "staregen_wheels"
+    factory.addToSpacecraft(rw.ModelTag, rw, sc)
+    sim.AddModelToTask(task, rw, _PRIORITY["wheels"])
+    return factory, rw
+
+
+def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig = SimConfig(), stream: int = 0,
+                options: BasiliskOptions = BasiliskOptions()) -> History:
+    """Fly `controller` (stepped at the control period) staring at (lon, lat) in Basilisk."""
+    bsk = basilisk()
+    sub, n_ctrl = cfg.substeps, cfg.control_steps
+    n = n_ctrl * sub
+    env0 = environment_track(2, cfg.plant_step)
+    x0 = initial_state(env0, lon, lat)
+    L_bi0 = dcm_from_quat3(x0[0:4])
+    omega0 = x0[4:7]
+
+    sim = bsk.base.SimBaseClass()
+    task = "staring"
+    sim.CreateNewProcess("dynamics").addTask(sim.CreateNewTask(task, _nanos(cfg.plant_step)))
+    sc = bsk.spacecraft.Spacecraft()
+    sc.ModelTag = "staregen"
+    js = _wheel_inertia(cfg)
+    sc.hub.mHub = float(cfg.spacecraft.mass)
+    sc.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+    sc.hub.IHubPntBc_B = bsk.helpers.np2EigenMatrix3d(list((cfg.spacecraft.inertia + js * np.eye(3)).ravel()))
+    state0 = orbit.table5_initial_state()
+    sc.hub.r_CN_NInit = [[float(v)] for v in state0[:3]]
+    sc.hub.v_CN_NInit = [[float(v)] for v in state0[3:]]
+    sc.hub.sigma_BNInit = [[float(v)] for v in bsk.rbk.C2MRP(L_bi0)]
+    sc.hub.omega_BN_BInit = [[float(v)] for v in omega0]
+    sim.AddModelToTask(task, sc, _PRIORITY["spacecraft"])
+
+    grav = bsk.grav.gravBodyFactory()
+    earth = grav.createEarth()
+    earth.isCentralBody = True
+    earth.mu = MU_EARTH
+    grav.addBodiesTo(sc)
+    if options.gravity_gradient and cfg.external_torques:
+        gg = bsk.gg.GravityGradientEffector()
+        gg.ModelTag = sc.ModelTag
+        gg.addPlanetName(earth.planetName)
+        sc.addDynamicEffector(gg)
+        sim.AddModelToTask(task, gg, _PRIORITY["wheels"])
+
+    factory, rw = _add_wheels(bsk, sim, task, sc, cfg, omega0)
+    drive = _StaringDrive(controller, lon, lat, cfg, stream, n)
+    module = _module_class(bsk)(drive, wheels=True)
+    module.ModelTag = "staregen_flight"
+    module.scStateInMsg.subscribeTo(sc.scStateOutMsg)
+    rw.rwMotorCmdInMsg.subscribeTo(module.rwMotorTorqueOutMsg)
+    sim.AddModelToTask(task, module, _PRIORITY["flight"])
+    states = sc.scStateOutMsg.recorder()
+    speeds = rw.rwSpeedOutMsg.recorder()
+    sim.AddModelToTask(task, states, _PRIORITY["recorders"])
+    sim.AddModelToTask(task, speeds, _PRIORITY["recorders"])
+
+    controller.reset()
+    sim.InitializeSimulation()
+    sim.ConfigureStopTime(_nanos(n * cfg.plant_step))
+    sim.ExecuteSimulation()
+    return _staring_history(states, speeds, drive, js, n, lon, lat, cfg, stream, bsk)
+
+
+def _staring_history(states, speeds, drive: _StaringDrive, js: float, n: int, lon, lat, cfg: SimConfig,
+                     stream: int, bsk) -> History:
+    """staregen's History of the recorded run: true errors from Basilisk's own orbit and attitude."""
+    if len(states.times()) != n + 1:
+        raise HostError(f"Basilisk recorded {len(states.times())} states, expected {n + 1}")
+    t = np.arange(n + 1) * cfg.plant_step
+    R, V = np.array(states.r_BN_N, float), np.array(states.v_BN_N, float)
+    L_bi = np.array([bsk.rbk.MRP2C(s) for s in np.array(states.sigma_BN, float)])
+    q_bi = quat_from_dcm(L_bi)
+    w = np.array(states.omega_BN_B, float)
+    h_w = js * (np.array(speeds.wheelSpeeds, float)[:, :3] + w)   # absolute momentum, axes = body axes
+    jd, sec = add_seconds(*SCENARIO_EPOCH, t)
+    env = EnvironmentTrack(t, jd, sec, np.hstack([R, V]))
+    A_bd, omega_e, d = true_errors(env, q_bi, w, lon, lat)
+    drive.rec_cmd[n], drive.rec_applied[n] = drive.rec_cmd[n - 1], drive.rec_applied[n - 1]
+    drive.mode[n] = drive.mode[n - 1]
+    nan = np.full((n + 1, 3), np.nan)
+    return History(t=t, A_bd=A_bd, omega_e=omega_e, omega_b=w, omega_d=d.omega_d, omegadot_d=d.omegadot_d,
+                   q_bi=q_bi, h_w=h_w, torque_cmd=drive.rec_cmd, torque_applied=drive.rec_applied,
+                   torque_ext=nan, A_bd_ctrl=nan.copy(), omega_e_ctrl=nan.copy(), mode=drive.mode.astype(str),
+                   lon=float(lon), lat=float(lat), seed=cfg.seed, stream=stream)
