@@ -3,6 +3,11 @@ scenario and paper 000's example built in an independent simulator. This is the 
 imports Basilisk; it does so when a run starts (the import takes seconds, and the extra is optional),
 and a missing extra is one line.
 
+Paper 000's example (section 4.2, host.sim.tanh_example): a hub with J of eq. 27 and no orbit, the
+law's torque and the example's disturbance d(t) as a body torque (extForceTorque), d evaluated at
+the start of each plant step and held over it (staregen's RK4 evaluates it in every stage: at
+dt = 5e-4 s the two differ by < 1e-7 N·m); R_c = [NB] = C(σ_BN)ᵀ.
+
 Staring scenario (docs/basilisk.md gives the mapping and the differences measured):
 * hub: Table 6 mass and inertia. Basilisk's balanced wheels add only Js·g·gᵀ to the spin axes
   (their back-substitution removes it again), so the hub gets I + Σ Js·g·gᵀ: with the wheels'
@@ -25,7 +30,6 @@ from __future__ import annotations
 
 import importlib
 from importlib import metadata
-from dataclasses import dataclass
 from types import SimpleNamespace
 from typing import Callable
 
@@ -41,6 +45,7 @@ from host.plant import orbit
 from host.plant.environment import EnvironmentTrack, L_oi
 from host.plant.sensors import measure
 from host.plant.spacecraft import saturate_torque
+from host.sim import tanh_example as tanh_ex
 from host.sim.simulator import SCENARIO_EPOCH, History, SimConfig, environment_track, initial_state, run_noise, \
     true_errors
 
@@ -76,11 +81,6 @@ def basilisk() -> SimpleNamespace:
 
 def _nanos(seconds: float) -> int:
     return int(round(seconds * 1e9))
-
-
-@dataclass(frozen=True)
-class BasiliskOptions:
-    gravity_gradient: bool = True
 
 
 # ----------------------------------------------------------------------------- the flight module
@@ -175,9 +175,9 @@ def _add_wheels(bsk, sim, task: str, sc, cfg: SimConfig, omega0: np.ndarray):
     return factory, rw
 
 
-def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig = SimConfig(), stream: int = 0,
-                options: BasiliskOptions = BasiliskOptions()) -> History:
-    """Fly `controller` (stepped at the control period) staring at (lon, lat) in Basilisk."""
+def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig = SimConfig(), stream: int = 0) -> History:
+    """Fly `controller` (stepped at the control period) staring at (lon, lat) in Basilisk; the
+    signature of host.sim.simulator.simulate (cfg.external_torques switches the gravity gradient)."""
     bsk = basilisk()
     sub, n_ctrl = cfg.substeps, cfg.control_steps
     n = n_ctrl * sub
@@ -207,7 +207,7 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
     earth.isCentralBody = True
     earth.mu = MU_EARTH
     grav.addBodiesTo(sc)
-    if options.gravity_gradient and cfg.external_torques:
+    if cfg.external_torques:
         gg = bsk.gg.GravityGradientEffector()
         gg.ModelTag = sc.ModelTag
         gg.addPlanetName(earth.planetName)
@@ -254,3 +254,80 @@ def _staring_history(states, speeds, drive: _StaringDrive, js: float, n: int, lo
                    q_bi=q_bi, h_w=h_w, torque_cmd=drive.rec_cmd, torque_applied=drive.rec_applied,
                    torque_ext=nan, A_bd_ctrl=nan.copy(), omega_e_ctrl=nan.copy(), mode=drive.mode.astype(str),
                    lon=float(lon), lat=float(lat), seed=cfg.seed, stream=stream)
+
+
+# ----------------------------------------------------------------------------- paper 000's example
+
+class _TanhDrive:
+    """The tanh law stepped at the control instants (torque held), plus d(t) at every plant step."""
+
+    def __init__(self, law, sc: "tanh_ex.Scenario", period: float, dt: float, n_sub: int, n: int):
+        self.law, self.sc, self.dt, self.n_sub = law, sc, dt, n_sub
+        self.disturbance = tanh_ex.plant(sc).disturbance
+        self.out = None
+        self.rows = np.empty(n + 1, dtype=object)
+
+    def __call__(self, j: int, st) -> np.ndarray:
+        if j % self.n_sub == 0:
+            R_c = np.array(basilisk().rbk.MRP2C(np.array(st.sigma_BN, float)), float).T
+            self.out = self.law.step(R_c, np.array(st.omega_BN_B, float), self.sc.R_t, self.sc.w_t,
+                                     self.sc.wdot_t)[0]
+        if j < len(self.rows):
+            self.rows[j] = self.out
+        torque = self.out["torque"].astype(float)
+        return torque + np.asarray(self.disturbance(j * self.dt), float)
+
+
+def tanh_run(law, period: float, duration: float, dt: float) -> dict:
+    """Paper 000's example flown in Basilisk by `law` (host.control.package_controller.PackageTanhLaw):
+    tanh_example's history (t, e, w_e, x2, u, varpi, status at every plant step, R_c_final)."""
+    bsk = basilisk()
+    sc = tanh_ex.paper_scenario()
+    n_ctrl, n_sub = tanh_ex.step_count(duration, period), tanh_ex.step_count(period, dt)
+    h = period / n_sub
+    n = n_ctrl * n_sub
+    sim = bsk.base.SimBaseClass()
+    task = "tanh"
+    sim.CreateNewProcess("dynamics").addTask(sim.CreateNewTask(task, _nanos(h)))
+    body = bsk.spacecraft.Spacecraft()
+    body.ModelTag = "paper000"
+    body.hub.mHub = 100.0   # kg; the example's translation is not simulated (no gravity), any mass will do
+    body.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+    body.hub.IHubPntBc_B = bsk.helpers.np2EigenMatrix3d([x for row in sc.plant_inertia for x in row])
+    body.hub.sigma_BNInit = [[float(v)] for v in bsk.rbk.C2MRP(np.array(sc.R_c0, float).T)]
+    body.hub.omega_BN_BInit = [[float(v)] for v in sc.w_c0]
+    sim.AddModelToTask(task, body, _PRIORITY["spacecraft"])
+    ext = bsk.ext.ExtForceTorque()
+    ext.ModelTag = "paper000_torque"
+    body.addDynamicEffector(ext)
+    sim.AddModelToTask(task, ext, _PRIORITY["wheels"])
+    law.reset()
+    drive = _TanhDrive(law, sc, period, h, n_sub, n)
+    module = _module_class(bsk)(drive, wheels=False)
+    module.ModelTag = "staregen_tanh"
+    module.scStateInMsg.subscribeTo(body.scStateOutMsg)
+    ext.cmdTorqueInMsg.subscribeTo(module.cmdTorqueOutMsg)
+    sim.AddModelToTask(task, module, _PRIORITY["flight"])
+    states = body.scStateOutMsg.recorder()
+    sim.AddModelToTask(task, states, _PRIORITY["recorders"])
+    sim.InitializeSimulation()
+    sim.ConfigureStopTime(_nanos(n * h))
+    sim.ExecuteSimulation()
+    return _tanh_history(sc, states, drive, n, h, bsk)
+
+
+def _tanh_history(sc, states, drive: _TanhDrive, n: int, h: float, bsk) -> dict:
+    if len(states.times()) != n + 1:
+        raise HostError(f"Basilisk recorded {len(states.times())} states, expected {n + 1}")
+    c = tanh_ex.compile_constants(sc.params)
+    hist = tanh_ex.History(n + 1)
+    w_all = np.array(states.omega_BN_B, float)
+    R_all = [np.array(bsk.rbk.MRP2C(s), float).T for s in np.array(states.sigma_BN, float)]
+    for j in range(n + 1):
+        y = [float(x) for x in R_all[j].ravel()] + [float(x) for x in w_all[j]]
+        e, w_e = tanh_ex.true_errors(c, sc, y)
+        row = drive.rows[j]
+        out = SimpleNamespace(torque=row["torque"].astype(float), x1=e, x2=row["x2"].astype(float), w_e=w_e,
+                              status=int(row["status"]))
+        hist.add(j * h, out, row["varpi"].astype(float), e, w_e)
+    return {**hist.as_dict(), "R_c_final": R_all[-1]}

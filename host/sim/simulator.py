@@ -237,16 +237,20 @@ def _history(rec: _Recorder, env: EnvironmentTrack, n: int, lon, lat, cfg: SimCo
 
 # ----------------------------------------------------------------------------- many targets
 
-def _simulate_one(make_controller: Callable[[], Controller], lon, lat, config, stream) -> History:
-    return simulate(make_controller(), lon, lat, config, stream)
+Engine = Callable[[Controller, float, float, SimConfig, int], History]
+
+
+def _simulate_one(make_controller: Callable[[], Controller], lon, lat, config, stream, engine: Engine) -> History:
+    return engine(make_controller(), lon, lat, config, stream)
 
 
 def simulate_targets(make_controller: Callable[[], Controller], targets: Sequence[tuple[float, float]],
                      config: SimConfig = SimConfig(), workers: int | None = None,
-                     progress: bool = True) -> list[History]:
+                     progress: bool = True, engine: Engine = simulate) -> list[History]:
     """One run per (lon, lat) target, target i on noise stream i, in a process pool.
 
-    `make_controller` must be picklable (a module-level function or functools.partial). Results
+    `make_controller` must be picklable (a module-level function or functools.partial), and so must
+    `engine` (the simulator: `simulate`, or another with its signature, e.g. Basilisk's). Results
     come back in target order whatever order the workers finish in.
     """
     from tqdm import tqdm
@@ -257,11 +261,11 @@ def simulate_targets(make_controller: Callable[[], Controller], targets: Sequenc
     try:
         if workers == 1:
             for i, (lon, lat) in enumerate(targets):
-                results[i] = _simulate_one(make_controller, lon, lat, config, i)
+                results[i] = _simulate_one(make_controller, lon, lat, config, i, engine)
                 bar.update()
         else:
             with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-                futures = {pool.submit(_simulate_one, make_controller, lon, lat, config, i): i
+                futures = {pool.submit(_simulate_one, make_controller, lon, lat, config, i, engine): i
                            for i, (lon, lat) in enumerate(targets)}
                 for fut in as_completed(futures):
                     results[futures[fut]] = fut.result()
