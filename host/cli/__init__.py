@@ -43,6 +43,7 @@ COMMANDS = [
     "host.cli.tanh",
     "host.cli.dp",
     "host.cli.gp",
+    "host.cli.basilisk",
 ]
 
 

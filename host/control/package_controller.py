@@ -14,11 +14,27 @@ from codegen.units.controller import emit as controller_records
 from codegen.units.tanh import emit as tanh_records
 from host.control.controllers import ControlOutput, Measurement
 from host.control.generated_controller import control_output, pack_input
-from tools.package_lib import FlightPackage, Records
+from tools.package_lib import FlightPackage, Records, load_package
 
 CONTROLLER_RECORDS = Records(controller_records.INPUT_DTYPE, controller_records.OUTPUT_DTYPE,
                              controller_records.STATE_DTYPE)
 TANH_RECORDS = Records(tanh_records.INPUT_DTYPE, tanh_records.OUTPUT_DTYPE, tanh_records.STATE_DTYPE)
+
+
+_loaded: dict[str, FlightPackage] = {}
+
+
+def loaded_package(folder: str) -> FlightPackage:
+    """The package in `folder`, checked, built and self-tested once per process (worker processes
+    of a many-target run each load it once)."""
+    if folder not in _loaded:
+        _loaded[folder] = load_package(folder)
+    return _loaded[folder]
+
+
+def make_package_controller(folder: str, name: str = "fig2") -> "PackageController":
+    """A picklable factory (functools.partial of it) for host.sim.simulator.simulate_targets."""
+    return PackageController(loaded_package(folder), name)
 
 
 def pid_only(package: FlightPackage) -> bool:
