@@ -2,12 +2,15 @@
 PY ?= python3
 OUT ?= out/pipeline
 
-.PHONY: setup run test
+.PHONY: setup setup-test run test
 setup:
 	@bash tools/setup.sh
+
+setup-test:
+	@bash tools/setup.sh test
 
 run: setup
 	staregen pipeline --out $(OUT)
 
-test: setup
+test: setup-test
 	$(PY) -m pytest -q -n 2

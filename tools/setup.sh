@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Idempotent set-up for a fresh Debian machine: the ARM toolchain, cmake and cppcheck from Debian, then the
 # Python package (torch pinned to the CPU wheel first so nothing pulls CUDA builds).
+# `setup.sh test` (make test) also installs the optional extra `basilisk` (bsk, Basilisk), which the tests
+# of `staregen basilisk` run; the main job does not need it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,11 +28,17 @@ if ! command -v cmake >/dev/null 2>&1 || ! command -v cppcheck >/dev/null 2>&1 \
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq cmake cppcheck llvm clang qemu-system-arm >/dev/null
 fi
 
+extras="dev"
+check="import host, codegen, tools, firmware, torch"
+if [ "${1:-}" = "test" ]; then
+  extras="dev,basilisk"
+  check="$check, Basilisk"
+fi
 stamp=.setup-stamp
-want="$(sha256sum pyproject.toml | cut -d' ' -f1)"
-if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || ! python3 -c "import host, codegen, tools, firmware, torch" 2>/dev/null; then
-  echo "setup: pip install torch==2.13.0 and -e .[dev]"
+want="$(sha256sum pyproject.toml | cut -d' ' -f1) $extras"
+if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ] || ! python3 -c "$check" 2>/dev/null; then
+  echo "setup: pip install torch==2.13.0 and -e .[$extras]"
   python3 -m pip install -q --disable-pip-version-check "torch==2.13.0"
-  python3 -m pip install -q --disable-pip-version-check -e ".[dev]"
+  python3 -m pip install -q --disable-pip-version-check -e ".[$extras]"
   echo "$want" > "$stamp"
 fi

@@ -9,6 +9,7 @@ complete, and only when the gate and the self-test on x86 and ARM found no misma
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import hashlib
 from pathlib import Path
 
@@ -37,6 +38,9 @@ def register(subparsers) -> None:
     p.add_argument("--tanh", default=None, metavar="FILE", help="shorthand for --params tanh=FILE")
     p.add_argument("--out", required=True, metavar="DIR", help="package folder (new or empty, or replaced if it holds "
                    "exactly a staregen package)")
+    p.add_argument("--pid-only", action="store_true",
+                   help="emit the controller's network envelope empty: every step flies the PID fallback (a PID-only "
+                        "package: the paper's PID alone, e.g. `staregen basilisk --controller pid`)")
     p.add_argument("--sign-key", default=None, metavar="FILE", help="key file (at least 32 random bytes, kept by "
                    "you): sign the manifest with HMAC-SHA256 (`package check --verify-key FILE`)")
     add_evidence_arguments(p)
@@ -112,6 +116,8 @@ def run(args: argparse.Namespace) -> int:
     plan = evidence_plan(args)
     sign_key = load_key(args.sign_key) if args.sign_key is not None else None
     cfg = pc.load(args.config)
+    if args.pid_only:
+        cfg = dataclasses.replace(cfg, controller=dataclasses.replace(cfg.controller, pid_only=True))
     network = art.load(args.network)
     files = parameter_files(args)
     params = {unit: unit_registry.get(unit).load_params(path) for unit, path in files.items()}

@@ -1,0 +1,80 @@
+"""`staregen basilisk`: end to end on short runs, and every bad input one line, exit 2, nothing built."""
+from __future__ import annotations
+
+import json
+import shutil
+
+import pytest
+
+from firmware import x86
+from host.sim import basilisk
+from tests.host.cli.package_inputs import cli
+
+
+def test_fig2_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys):
+    out = tmp_path / "fly"
+    code, stdout, err = cli(capsys, "basilisk", "--package", flight_package, "--controller", "fig2",
+                            "--duration", "12", "--errors", "off", "--compare", "--out", out)
+    assert code == 0, err
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["scenario"]["simulator"] == f"Basilisk {basilisk.BSK_VERSION}"
+    assert metrics["scenario"]["disturbances"] == ["gravity gradient"]
+    assert metrics["simulation"]["sensor_errors"] is False and metrics["J_A"] > 0
+    check = json.loads((out / "crosscheck.json").read_text())
+    assert check["per_target_within_2_percent"] is True
+    assert check["max_relative_difference"]["J_A"] < 0.02 and check["max_attitude_diff_deg"] < 1e-5
+    for name in ("history.npz", "euler_error.png", "rate_error.png", "crosscheck_overlay.png"):
+        assert (out / name).stat().st_size > 0
+    assert "cross-check, Basilisk against staregen's simulator" in stdout and "within" in stdout
+
+
+def test_tanh_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys):
+    out = tmp_path / "tanh"
+    code, stdout, err = cli(capsys, "basilisk", "--package", flight_package, "--controller", "tanh",
+                            "--duration", "25", "--dt", "0.005", "--compare", "--out", out)
+    assert code == 0, err
+    m = json.loads((out / "metrics.json").read_text())
+    assert m["torque_within_bound"] is True and m["torque_bound"] == 4.5
+    assert m["crosscheck"]["within"] is True and abs(m["crosscheck"]["relative_difference"]) < 0.05
+    assert (out / "crosscheck_overlay.png").stat().st_size > 0
+
+
+def _one_line_error(capsys, *argv) -> str:
+    code, stdout, err = cli(capsys, "basilisk", *argv)
+    assert code == 2 and stdout == "" and len(err.strip().splitlines()) == 1, (code, stdout, err)
+    return err
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--controller", "lqr"], "unknown controller 'lqr' for basilisk (one of: fig2, pid, tanh)"),
+    (["--controller", "fig2", "--dt", "0.01"], "--dt applies to --controller tanh only"),
+    (["--controller", "tanh", "--target", "all"], "--target does not apply to --controller tanh"),
+    (["--controller", "pid"], "its controller flies its network; for --controller pid generate one with"),
+    (["--duration", "-1"], "--duration"),
+    (["--target", "500,0"], "target"),
+])
+def test_bad_arguments(flight_package, tmp_path, capsys, argv, message):
+    err = _one_line_error(capsys, "--package", flight_package, *argv, "--out", tmp_path / "o")
+    assert message in err
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_package_that_fails_its_check_is_never_loaded(flight_package, tmp_path, capsys, monkeypatch):
+    folder = tmp_path / "pkg"
+    shutil.copytree(flight_package, folder)
+    (folder / "src" / "stare.c").write_text("int main(void) { return 0; }\n")
+    monkeypatch.setattr(x86, "build", lambda *a, **k: pytest.fail("an edited package was compiled"))
+    err = _one_line_error(capsys, "--package", folder, "--out", tmp_path / "o")
+    assert "fails its check, not loaded: edited file: src/stare.c" in err
+
+
+def test_a_missing_extra_is_one_line(flight_package, tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(basilisk, "_loaded", None)
+    monkeypatch.setitem(basilisk._MODULES, "spacecraft", "Basilisk.simulation.no_such_module")
+    monkeypatch.setattr(x86, "build", lambda *a, **k: pytest.fail("built without Basilisk"))
+    err = _one_line_error(capsys, "--package", flight_package, "--out", tmp_path / "o")
+    assert "Basilisk is not installed (the optional extra `basilisk`: pip install -e '.[basilisk]')" in err
+
+
+def test_a_missing_package_folder_is_one_line(tmp_path, capsys):
+    assert "no such folder" in _one_line_error(capsys, "--package", tmp_path / "none", "--out", tmp_path / "o")
