@@ -1,10 +1,12 @@
-"""`staregen artifact check FILE` and `staregen artifact random --shape 12-40-3 --seed S --out FILE`."""
+"""`staregen artifact check FILE`, `staregen artifact random --shape 12-40-3 --seed S --out FILE` and
+`staregen artifact standin --out FILE`."""
 from __future__ import annotations
 
 import argparse
 
 from codegen import artifact as art
 from host.cli.args import parse_int
+from host.control.standin import fit_pid_standin
 
 
 def register(subparsers) -> None:
@@ -21,6 +23,11 @@ def register(subparsers) -> None:
     random.add_argument("--out", required=True, metavar="FILE", help="artifact to write")
     random.set_defaults(func=run_random)
 
+    standin = actions.add_parser("standin", help="write the stand-in network: 12-40-3 fitted to the Table 1 PID law "
+                                 "(what `simulate --controller nn-c` flies without --artifact; seconds, not a training)")
+    standin.add_argument("--out", required=True, metavar="FILE", help="artifact to write")
+    standin.set_defaults(func=run_standin)
+
 
 def run_check(args: argparse.Namespace) -> int:
     a = art.load(args.file)
@@ -33,4 +40,11 @@ def run_random(args: argparse.Namespace) -> int:
     a = art.random_artifact(art.parse_shape(args.shape), seed)   # refused before allocating
     path = a.save(args.out)
     print(f"wrote {path}: {a.shape_text}, seed {seed}, sha256 {a.sha256}")
+    return 0
+
+
+def run_standin(args: argparse.Namespace) -> int:
+    a = fit_pid_standin()
+    path = a.save(args.out)
+    print(f"wrote {path}: {a.shape_text} stand-in fitted to the Table 1 PID law, sha256 {a.sha256}")
     return 0

@@ -11,6 +11,7 @@ import host.cli as cli
 from codegen import artifact as art
 from codegen.errors import CodegenError
 from codegen.units.network import golden
+from host.control.nn_controller import load_artifact
 
 CODEGEN_COMMANDS = ["host.cli.artifact", "host.cli.codegen", "host.cli.c_eval", "host.cli.verify"]
 
@@ -302,3 +303,14 @@ def test_cli_bad_input_gives_one_line_and_non_zero_exit(monkeypatch, capsys, tmp
     code, out, err = run_cli(monkeypatch, capsys, *[a.format(**paths) for a in argv])
     assert code != 0
     assert len(err.strip().splitlines()) == 1 and needle in err and "Traceback" not in err
+
+
+def test_cli_standin_writes_the_stand_in_network(monkeypatch, capsys, tmp_path):
+    """`artifact standin`: the network `simulate --controller nn-c` flies without --artifact (the README's
+    Basilisk example generates its package from it); the fit is seeded, so the file is the same each time."""
+    out_file = tmp_path / "standin.json"
+    code, out, _ = run_cli(monkeypatch, capsys, "artifact", "standin", "--out", str(out_file))
+    assert code == 0 and "12-40-3 stand-in" in out
+    written = art.load(out_file)
+    assert written.shape_text == "12-40-3"
+    assert written.sha256 == load_artifact(None).sha256
