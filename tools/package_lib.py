@@ -60,7 +60,10 @@ def _read_sources(folder: Path) -> dict[str, str]:
         for path in sorted((folder / sub).glob("*.[ch]")):
             if path.name in sources:
                 raise ToolError(f"package: {path.name} appears twice ({sub}/ and another folder)")
-            sources[path.name] = path.read_text(encoding="utf-8")
+            try:
+                sources[path.name] = path.read_text(encoding="utf-8")
+            except UnicodeDecodeError:
+                raise ToolError(f"package: {sub}/{path.name} is not UTF-8 text") from None
     return sources
 
 

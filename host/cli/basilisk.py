@@ -170,7 +170,12 @@ def _check_tanh_unit(package, folder: str) -> tuple[float, float]:
     """(period, torque bound) of the package's tanh unit, which must be paper 000's example law."""
     if "tanh" not in package.entries:
         raise HostError(f"package {folder} holds no tanh unit (generate with units = [..., \"tanh\"])")
-    period = package.manifest["config"]["timing"]["control_period"]
+    config = package.manifest.get("config")
+    timing = config.get("timing") if isinstance(config, dict) else None
+    period = timing.get("control_period") if isinstance(timing, dict) else None
+    if isinstance(period, bool) or not isinstance(period, (int, float)) or not 1e-4 <= period <= 10.0:
+        raise HostError(f"package {folder}: its manifest's config.timing.control_period is not a period in "
+                        "[1e-4, 10] s")
     params = unit_registry.get("tanh").load_params(PAPER000_PARAMS)
     want = TanhUnit(params, period, name=f"{package.name}_tanh").identity()
     if package.manifest["units"]["tanh"].get("identity") != want:
@@ -193,23 +198,26 @@ def run_tanh(args, package, out: Path) -> int:
                "settle_threshold": tanh_example.SETTLE_THRESHOLD, "torque_bound": bound,
                "torque_within_bound": bool(np.max(np.abs(history["u"])) <= bound),
                "runtime_s": round(time.perf_counter() - start, 3)}
-    reference = tanh_in_loop.run_in_loop("x86", period, duration, dt) if args.compare else None
+    reference = None
+    if args.compare:      # the same package object code, a fresh state, in staregen's plant
+        law = PackageTanhLaw(package)
+        reference = tanh_in_loop.fly(tanh_example.paper_scenario(), law.entry.step, period, duration, dt)
     if reference is not None:
-        ts, tb = reference["t_settle"], metrics["t_settle"]
+        ts, tb = tanh_example.metrics_of(reference)["t_settle"], metrics["t_settle"]
         rel = None if ts is None or tb is None else (tb - ts) / ts
         metrics["crosscheck"] = {"t_settle_staregen": ts, "t_settle_basilisk": tb, "relative_difference": rel,
                                  "tolerance": TANH_SETTLE_TOLERANCE,
                                  "within": rel is not None and abs(rel) <= TANH_SETTLE_TOLERANCE,
                                  "max_abs_e_norm_difference": float(np.max(np.abs(
                                      np.linalg.norm(history["e"], axis=1)
-                                     - np.linalg.norm(reference["history"]["e"], axis=1))))}
+                                     - np.linalg.norm(reference["e"], axis=1))))}
     with atomic.directory(out) as tmp:
         tanh_example.write_outputs(tmp, metrics, history)
         if reference is not None:
-            ref = reference["history"]
+            ref = reference
             crosscheck.plot_overlay(history["t"], [("e", ref["e"], history["e"]), ("u [N*m]", ref["u"], history["u"])],
                                     tmp / "crosscheck_overlay.png",
-                                    "tanh law, paper 000: staregen SIL (solid) and Basilisk (dashed)")
+                                    "tanh law, paper 000: staregen (solid) and Basilisk (dashed), the package's C in both")
     print(f"  t_settle (|e| < {tanh_example.SETTLE_THRESHOLD:g} to stay) {metrics['t_settle']} s, e_final "
           f"{metrics['e_final']:.3e}, max |u| {metrics['u_max']:.4g} N*m (bound {bound:g}: "
           + ("within" if metrics["torque_within_bound"] else "EXCEEDED") + ")")

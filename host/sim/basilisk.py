@@ -127,7 +127,7 @@ class _StaringDrive:
         self.noise = run_noise(cfg, cfg.seed, stream)
         self.sub = cfg.substeps
         self.cmd = np.zeros(3)
-        self.rec_cmd, self.rec_applied = np.zeros((n + 1, 3)), np.zeros((n + 1, 3))
+        self.rec_cmd = np.zeros((n + 1, 3))
         self.mode = np.empty(n + 1, dtype=object)
 
     def measurement(self, j: int, st, bsk) -> Measurement:
@@ -151,7 +151,7 @@ class _StaringDrive:
         applied = saturate_torque(self.cmd, self.cfg.spacecraft.torque_limit)
         if self.cfg.wheel_errors and j < len(self.mode) - 1:
             applied = (applied + self.cfg.errors.wheels.bias_array) + self.noise.wheels[j]
-        self.rec_cmd[j], self.rec_applied[j] = self.cmd, applied
+        self.rec_cmd[j] = self.cmd
         return applied
 
 
@@ -223,18 +223,20 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
     sim.AddModelToTask(task, module, _PRIORITY["flight"])
     states = sc.scStateOutMsg.recorder()
     speeds = rw.rwSpeedOutMsg.recorder()
-    sim.AddModelToTask(task, states, _PRIORITY["recorders"])
-    sim.AddModelToTask(task, speeds, _PRIORITY["recorders"])
+    wheels = [rw.rwOutMsgs[i].recorder() for i in range(3)]   # u_current: the torque Basilisk applies
+    for recorder in (states, speeds, *wheels):
+        sim.AddModelToTask(task, recorder, _PRIORITY["recorders"])
 
     controller.reset()
     sim.InitializeSimulation()
     sim.ConfigureStopTime(_nanos(n * cfg.plant_step))
     sim.ExecuteSimulation()
-    return _staring_history(states, speeds, drive, js, n, lon, lat, cfg, stream, bsk)
+    applied = -np.stack([np.array(w.u_current, float) for w in wheels], axis=1)   # body torque = −u_s
+    return _staring_history(states, speeds, applied, drive, js, n, lon, lat, cfg, stream, bsk)
 
 
-def _staring_history(states, speeds, drive: _StaringDrive, js: float, n: int, lon, lat, cfg: SimConfig,
-                     stream: int, bsk) -> History:
+def _staring_history(states, speeds, applied: np.ndarray, drive: _StaringDrive, js: float, n: int, lon, lat,
+                     cfg: SimConfig, stream: int, bsk) -> History:
     """staregen's History of the recorded run: true errors from Basilisk's own orbit and attitude."""
     if len(states.times()) != n + 1:
         raise HostError(f"Basilisk recorded {len(states.times())} states, expected {n + 1}")
@@ -247,11 +249,12 @@ def _staring_history(states, speeds, drive: _StaringDrive, js: float, n: int, lo
     jd, sec = add_seconds(*SCENARIO_EPOCH, t)
     env = EnvironmentTrack(t, jd, sec, np.hstack([R, V]))
     A_bd, omega_e, d = true_errors(env, q_bi, w, lon, lat)
-    drive.rec_cmd[n], drive.rec_applied[n] = drive.rec_cmd[n - 1], drive.rec_applied[n - 1]
-    drive.mode[n] = drive.mode[n - 1]
+    drive.rec_cmd[n], drive.mode[n] = drive.rec_cmd[n - 1], drive.mode[n - 1]
+    applied = applied.copy()
+    applied[n] = applied[n - 1]     # as staregen: no interval follows the last sample
     nan = np.full((n + 1, 3), np.nan)
     return History(t=t, A_bd=A_bd, omega_e=omega_e, omega_b=w, omega_d=d.omega_d, omegadot_d=d.omegadot_d,
-                   q_bi=q_bi, h_w=h_w, torque_cmd=drive.rec_cmd, torque_applied=drive.rec_applied,
+                   q_bi=q_bi, h_w=h_w, torque_cmd=drive.rec_cmd, torque_applied=applied,
                    torque_ext=nan, A_bd_ctrl=nan.copy(), omega_e_ctrl=nan.copy(), mode=drive.mode.astype(str),
                    lon=float(lon), lat=float(lat), seed=cfg.seed, stream=stream)
 

@@ -56,6 +56,17 @@ def simulate_in_loop(sc, target: str, period: float, duration: float, dt: float)
     plus `golden_mismatch_steps`, `records` (state before, input of every step) and, for PIL,
     `cycles` (per step, ideal memory)."""
     loop = InTheLoop(TanhUnit(sc.params, period), target)
+    result = fly(sc, loop.step, period, duration, dt)
+    inputs, _ = loop.trace()
+    result.update({"golden_mismatch_steps": loop.mismatch_steps, "records": Batch(loop.state_records(), inputs)})
+    if target == "arm":
+        result["cycles"] = np.array(loop.cycles, dtype=np.int64)
+    return result
+
+
+def fly(sc, step, period: float, duration: float, dt: float) -> dict:
+    """The sampled example with `step(input record) -> output record` as the law (the unit in the loop,
+    or a flight package's own `<name>_tanh_step`): the history, R_c_final and control_steps."""
     body = ex.plant(sc)
     c = ex.compile_constants(sc.params)
     n_ctrl, n_sub = ex.step_count(duration, period), ex.step_count(period, dt)
@@ -63,7 +74,7 @@ def simulate_in_loop(sc, target: str, period: float, duration: float, dt: float)
     hist = ex.History(n_ctrl * n_sub + 1)
     y = ex.initial_state(sc)
     for kk in range(n_ctrl + 1):
-        row = loop.step(input_record(rows(y), y[9:12], sc))[0]
+        row = step(input_record(rows(y), y[9:12], sc))[0]
         _, w_e = ex.true_errors(c, sc, y)
         out = _Law(tuple(map(float, row["torque"])), tuple(map(float, row["x1"])), tuple(map(float, row["x2"])),
                    w_e, int(row["status"]))
@@ -78,12 +89,7 @@ def simulate_in_loop(sc, target: str, period: float, duration: float, dt: float)
             else:
                 hist.add(t, out, varpi)
             y = body.rk4_step(t, y, h, out.torque)
-    inputs, _ = loop.trace()
-    result = {**hist.as_dict(), "R_c_final": np.array(rows(y)), "golden_mismatch_steps": loop.mismatch_steps,
-              "control_steps": n_ctrl + 1, "records": Batch(loop.state_records(), inputs)}
-    if target == "arm":
-        result["cycles"] = np.array(loop.cycles, dtype=np.int64)
-    return result
+    return {**hist.as_dict(), "R_c_final": np.array(rows(y)), "control_steps": n_ctrl + 1}
 
 
 def run_in_loop(target: str, period: float = DEFAULT_PERIOD, duration: float = 40.0, dt: float = 5e-4,

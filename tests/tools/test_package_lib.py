@@ -3,6 +3,7 @@ package that fails its check is never compiled, one whose self-test fails is ref
 from __future__ import annotations
 
 import json
+import re
 import shutil
 
 import numpy as np
@@ -66,12 +67,7 @@ def test_a_package_whose_self_test_fails_is_refused(flight_package, tmp_path):
     text = nn.read_text()
     i = text.index("0x1.")                   # the first hex-float constant (a weight)
     nn.write_text(text[:i + 4] + ("0" if text[i + 4] != "0" else "1") + text[i + 5:])
-    doc = json.loads((folder / "manifest.json").read_text())
-    doc["files"]["src/stare_nn.c"] = manifest.sha256_bytes(nn.read_bytes())
-    doc.pop("sha256")
-    doc["sha256"] = manifest.seal_of(doc)
-    (folder / "manifest.json").write_text(json.dumps(doc, indent=2) + "\n")
-    assert manifest.check(folder)[1] == []
+    _resealed(folder, edit_file=("src/stare_nn.c", nn.read_bytes()))
     with pytest.raises(ToolError, match=r"self-test reports [1-9]\d* mismatching words; refusing to fly it"):
         load_package(folder)
 
@@ -83,6 +79,46 @@ def test_record_layouts_are_checked_and_unknown_units_refused(flight_package):
         pkg.entry("controller", short)
     with pytest.raises(ToolError, match=r"holds no gp unit \(it holds: controller, tanh\)"):
         pkg.entry("gp", CONTROLLER_RECORDS)
+
+
+def _resealed(folder, edit_file=None, edit_manifest=None):
+    """A copy edited and resealed (hashes and seal recomputed), so that it passes its check."""
+    doc = json.loads((folder / "manifest.json").read_text())
+    if edit_file is not None:
+        rel, data = edit_file
+        (folder / rel).write_bytes(data)
+        doc["files"][rel] = manifest.sha256_bytes(data)
+    if edit_manifest is not None:
+        edit_manifest(doc)
+    doc.pop("sha256")
+    doc["sha256"] = manifest.seal_of(doc)
+    (folder / "manifest.json").write_text(json.dumps(doc, indent=2) + "\n")
+    assert manifest.check(folder)[1] == []
+    return folder
+
+
+def test_a_source_that_is_not_utf8_is_one_line(flight_package, tmp_path):
+    folder = tmp_path / "pkg"
+    shutil.copytree(flight_package, folder)
+    data = (folder / "src" / "stare_tanh.c").read_bytes() + b"/* \xff\xfe */\n"
+    _resealed(folder, edit_file=("src/stare_tanh.c", data))
+    with pytest.raises(ToolError, match=r"src/stare_tanh.c is not UTF-8 text"):
+        load_package(folder)
+
+
+@pytest.mark.parametrize("units, message", [
+    ({"controller": {"entry": "stare); system(\"x"}}, "is not a C identifier staregen writes"),
+    ({"controller": "stare"}, "is not a C identifier staregen writes"),
+    ({"lqr": {"entry": "stare_lqr"}}, "unit 'lqr' is not a unit this staregen knows"),
+    ({}, "the manifest lists no units"),
+])
+def test_hostile_unit_names_never_reach_c(flight_package, tmp_path, monkeypatch, units, message):
+    folder = tmp_path / "pkg"
+    shutil.copytree(flight_package, folder)
+    _resealed(folder, edit_manifest=lambda doc: doc.__setitem__("units", units))
+    monkeypatch.setattr(x86, "build", lambda *a, **k: pytest.fail("a hostile manifest was compiled"))
+    with pytest.raises(ToolError, match=re.escape(message)):
+        load_package(folder)
 
 
 def test_a_missing_folder_is_one_line(tmp_path):

@@ -9,6 +9,7 @@ import pytest
 from firmware import x86
 from host.sim import basilisk
 from tests.host.cli.package_inputs import cli
+from tests.tools.test_package_lib import _resealed
 
 
 def test_fig2_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys):
@@ -66,6 +67,16 @@ def test_a_package_that_fails_its_check_is_never_loaded(flight_package, tmp_path
     monkeypatch.setattr(x86, "build", lambda *a, **k: pytest.fail("an edited package was compiled"))
     err = _one_line_error(capsys, "--package", folder, "--out", tmp_path / "o")
     assert "fails its check, not loaded: edited file: src/stare.c" in err
+
+
+@pytest.mark.parametrize("edit", [lambda d: d.pop("config"), lambda d: d["config"]["timing"].update(control_period="0.1"),
+                                  lambda d: d["config"]["timing"].update(control_period=True)])
+def test_a_manifest_without_a_usable_period_is_one_line(flight_package, tmp_path, capsys, edit):
+    folder = tmp_path / "pkg"
+    shutil.copytree(flight_package, folder)
+    _resealed(folder, edit_manifest=edit)
+    err = _one_line_error(capsys, "--package", folder, "--controller", "tanh", "--out", tmp_path / "o")
+    assert "config.timing.control_period is not a period" in err
 
 
 def test_a_missing_extra_is_one_line(flight_package, tmp_path, capsys, monkeypatch):
