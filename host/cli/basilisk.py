@@ -1,11 +1,12 @@
 """`staregen basilisk --package DIR --controller fig2|pid|tanh`: the flight package's C flown in Basilisk.
 
-fig2 / pid: the staring scenario (Table 5 orbit, Table 6 body and wheels, gravity gradient, the
+fig2 / pid: the staring scenario (Table 5 orbit, Table 6 body and wheels, disturbances, the
 scenario file's sensor and wheel errors) flown by the package's `<name>_step`; the same metrics
 file, histories and plots as `staregen simulate`. tanh: paper 000's example flown by
 `<name>_tanh_step`. `--compare` flies the same package object code in staregen's simulator from
 the same initial state with the same noise draws and writes the cross-check (crosscheck.json,
-overlay plot). The package is checked against its manifest before anything is compiled; one that
+overlay plot). The disturbances (gravity gradient, drag, residual magnetic dipole; each switchable) are the same
+model on both sides. The package is checked against its manifest before anything is compiled; one that
 fails is never loaded. Needs the optional extra `basilisk` (pip install -e '.[basilisk]').
 """
 from __future__ import annotations
@@ -21,7 +22,7 @@ import numpy as np
 from codegen import atomic
 from codegen import units as unit_registry
 from codegen.units.tanh.unit import TanhUnit
-from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number
+from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number, shown
 from host.cli.simulate import MAX_DURATION_S, build_plan
 from host.cli.units import PAPER000_PARAMS
 from host.control.package_controller import PackageTanhLaw, loaded_package, make_package_controller, pid_only
@@ -40,9 +41,9 @@ TANH_DEFAULT_DURATION_S = 40.0
 TANH_DEFAULT_DT = tanh_example.MAX_REFERENCE_STEP
 TANH_SETTLE_TOLERANCE = 0.05      # issue 28: the same convergence time within ±5 %
 OWNED = json_marker_owner("metrics.json")
-# Basilisk offers the gravity gradient without ephemerides; staregen's aerodynamic, solar and
-# magnetic torques are switched off on both sides (docs/basilisk.md).
-GRAVITY_GRADIENT_ONLY = DisturbanceParams(drag_area=0.0, srp_area=0.0, residual_dipole=np.zeros(3))
+# The disturbances both simulators model here (docs/basilisk.md); staregen's solar-radiation torque needs
+# the Sun's ephemeris, which Basilisk fetches at run time (SPICE), and is off on both sides.
+DISTURBANCES = ("gravity-gradient", "drag", "magnetic")
 
 
 def register(subparsers) -> None:
@@ -56,7 +57,9 @@ def register(subparsers) -> None:
     p.add_argument("--duration", default=None, help="simulated seconds (default 100; tanh 40)")
     p.add_argument("--errors", default="on", choices=("on", "off"),
                    help="the scenario's star sensor, gyro and wheel errors (default on)")
-    p.add_argument("--gravity-gradient", default="on", choices=("on", "off"), help="gravity-gradient torque (default on)")
+    p.add_argument("--disturbances", default=",".join(DISTURBANCES),
+                   help=f"comma-separated, each switchable: {', '.join(DISTURBANCES)}, or 'none' (default all three; "
+                        "solar radiation is off on both sides: Basilisk needs SPICE ephemerides for it)")
     add_scenario_argument(p)
     p.add_argument("--seed", default="0", help="noise seed (default 0)")
     p.add_argument("--t-img", default="1.0", help="imaging window length T_img in s (default 1)")
@@ -75,7 +78,7 @@ def _check_arguments(args) -> None:
         raise HostError(f"unknown controller {args.controller!r} for basilisk (one of: {', '.join(CONTROLLERS)})")
     if args.controller == "tanh":
         staring_only = [(n, v, d) for n, v, d in (("--target", args.target, "central"), ("--errors", args.errors, "on"),
-                                                  ("--gravity-gradient", args.gravity_gradient, "on"),
+                                                  ("--disturbances", args.disturbances, ",".join(DISTURBANCES)),
                                                   ("--seed", args.seed, "0"), ("--t-img", args.t_img, "1.0"),
                                                   ("--settle", args.settle, "10.0")) if v != d]
         staring_only += [(n, v, None) for n, v in (("--scenario", args.scenario), ("--workers", args.workers))
@@ -99,13 +102,29 @@ def main(args: argparse.Namespace) -> int:
 
 # ----------------------------------------------------------------------------- staring scenario
 
+def parse_disturbances(text: str) -> DisturbanceParams | None:
+    """staregen's disturbance model with the chosen torques on (the others at zero); None for 'none'."""
+    names = [n.strip() for n in text.split(",")]
+    if names == ["none"]:
+        return None
+    unknown = [n for n in names if n not in DISTURBANCES]
+    if unknown or not names:
+        raise HostError(f"--disturbances: unknown {shown(unknown[0] if unknown else text)} (any of "
+                        f"{', '.join(DISTURBANCES)}, comma-separated, or 'none')")
+    d = DisturbanceParams()
+    return dataclasses.replace(d, srp_area=0.0, gravity_gradient="gravity-gradient" in names,
+                               drag_area=d.drag_area if "drag" in names else 0.0,
+                               residual_dipole=d.residual_dipole if "magnetic" in names else np.zeros(3))
+
+
 def staring_config(args, scenario) -> SimConfig:
     errors = args.errors == "on"
+    disturbances = parse_disturbances(args.disturbances)
     return SimConfig(duration=parse_number(args.duration or str(DEFAULT_DURATION_S), "--duration", positive=True,
                                            maximum=MAX_DURATION_S),
                      seed=parse_int(args.seed, "--seed"), errors=scenario.errors, sensor_errors=errors,
-                     wheel_errors=errors, external_torques=args.gravity_gradient == "on",
-                     disturbances=GRAVITY_GRADIENT_ONLY)
+                     wheel_errors=errors, external_torques=disturbances is not None,
+                     disturbances=disturbances or DisturbanceParams())
 
 
 def _check_controller(package, controller: str, folder: str) -> None:
@@ -138,7 +157,7 @@ def run_staring(args, package, out: Path) -> int:
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
     make = functools.partial(make_package_controller, str(Path(args.package)), args.controller)
     described = {**scenario.describe(), "simulator": f"Basilisk {basilisk.BSK_VERSION}",
-                 "package": package.name, "disturbances": ["gravity gradient"] if cfg.external_torques else []}
+                 "package": package.name, "disturbances": basilisk.disturbance_names(cfg)}
     print(f"{args.controller}: package {package.name} in Basilisk {basilisk.BSK_VERSION}, {len(targets)} target(s), "
           f"{cfg.control_steps * cfg.control_period:g} s, errors {args.errors} ...", flush=True)
     flown = _campaign(f"{args.controller} (Basilisk)", targets, cfg, plan, make, workers, basilisk.staring_run)

@@ -34,6 +34,7 @@ class DisturbanceParams:
     srp_reflectivity: float = 0.6
     srp_cp_offset: np.ndarray = field(default_factory=lambda: np.array([0.05, 0.30, 0.10]))   # m, body
     residual_dipole: np.ndarray = field(default_factory=lambda: np.array([1.0, 1.0, 1.0]))    # A m^2, body
+    gravity_gradient: bool = True                # False: no gravity-gradient torque (a cross-check switch)
 
 
 DEFAULT_DISTURBANCES = DisturbanceParams()
@@ -68,7 +69,8 @@ def magnetic_torque(B_eci, L_bi, p: DisturbanceParams) -> np.ndarray:
 
 def total_disturbance_torque(env, k: int, L_bi, inertia, p: DisturbanceParams) -> np.ndarray:
     """Sum of the four torques at sample k of a host.plant.environment.EnvironmentTrack."""
-    return (gravity_gradient_torque(env.R[k], L_bi, inertia)
+    gg = gravity_gradient_torque(env.R[k], L_bi, inertia) if p.gravity_gradient else np.zeros(3)
+    return (gg
             + aerodynamic_torque(env.rho[k], env.v_rel[k], L_bi, p)
             + solar_radiation_torque(env.sun_dir[k], env.sunlit[k], L_bi, p)
             + magnetic_torque(env.B[k], L_bi, p))

@@ -60,13 +60,18 @@ def sunlit_fraction(R_s, r_sun) -> np.ndarray:
     return np.where((along < 0) & (perp < WGS84_A), 0.0, 1.0)
 
 
-def air_density(altitude_m) -> np.ndarray:
-    """Exponential atmosphere [kg/m^3] at geodetic-ish altitude (above a spherical WGS84_A)."""
+def atmosphere_band(altitude_m):
+    """(base altitude [m], density there [kg/m^3], scale height [m]) of the table row that holds altitude_m."""
     h_km = np.asarray(altitude_m, float) / 1e3
     rows = _EXPONENTIAL_ATMOSPHERE
     i = np.clip(np.searchsorted(rows[:, 0], h_km, side="right") - 1, 0, len(rows) - 1)
-    h0, rho0, H = rows[i, 0], rows[i, 1], rows[i, 2]
-    return rho0 * np.exp(-(h_km - h0) / H)
+    return rows[i, 0] * 1e3, rows[i, 1], rows[i, 2] * 1e3
+
+
+def air_density(altitude_m) -> np.ndarray:
+    """Exponential atmosphere [kg/m^3] at geodetic-ish altitude (above a spherical WGS84_A)."""
+    h0, rho0, H = atmosphere_band(altitude_m)
+    return rho0 * np.exp(-(np.asarray(altitude_m, float) - h0) / H)
 
 
 def velocity_relative_to_air(R_s, V_s, jd_days, sec_of_day) -> np.ndarray:

@@ -15,9 +15,11 @@ Staring scenario (docs/basilisk.md gives the mapping and the differences measure
 * orbit: Table 5's initial state, Earth as a point mass with staregen's μ (two-body, as staregen);
 * three orthogonal wheels: u_max = the torque limit, Ω_max·Js = the momentum limit, Js = h_max /
   Ω_max at 6000 rpm, no friction; started with Ω = −gᵀω₀ (h_w = 0, Table 6);
-* gravity gradient: Basilisk's GravityGradientEffector (switchable); staregen's aerodynamic, solar
-  and magnetic models have no ephemeris-free Basilisk counterpart here and are off on both sides of
-  the cross-check;
+* disturbances of cfg.disturbances, each switchable: the gravity gradient (GravityGradientEffector),
+  drag (cannonball drag at r_cp, the band of staregen's exponential table that holds the orbit, air
+  co-rotating with staregen's Earth rate), the residual dipole (a centred-dipole field with staregen's
+  IGRF coefficients on staregen's GMST-rotating Earth, held by a torque-rod effector); the solar
+  radiation torque needs SPICE ephemerides and is refused;
 * one dynamics task at staregen's plant step (RK4, Basilisk's default integrator). The models run
   in priority order: the spacecraft integrates to t_j and publishes, the flight module reads that
   state and (at each control instant) steps the package's C, then the wheel effector reads the
@@ -42,7 +44,9 @@ from host.core.timebase import add_seconds
 from host.core.vec3 import dcm_from_quat3
 from host.errors import HostError
 from host.plant import orbit
-from host.plant.environment import EnvironmentTrack, L_oi
+from host.plant.earth import L_ei, earth_rate_vector
+from host.plant.environment import EARTH_RADIUS_DIPOLE, IGRF2015_DIPOLE_NT, WGS84_A, EnvironmentTrack, L_oi, \
+    atmosphere_band
 from host.plant.sensors import measure
 from host.plant.spacecraft import saturate_torque
 from host.sim import tanh_example as tanh_ex
@@ -52,13 +56,17 @@ from host.sim.simulator import SCENARIO_EPOCH, History, SimConfig, environment_t
 BSK_VERSION = "2.12.1"
 INSTALL_HINT = "pip install -e '.[basilisk]'"
 WHEEL_MAX_RPM = 6000.0
-_PRIORITY = {"spacecraft": 300, "flight": 200, "wheels": 100, "recorders": 50}
+_PRIORITY = {"spacecraft": 300, "earth": 290, "environment": 280, "effectors": 270, "flight": 200, "wheels": 100,
+             "recorders": 50}
 _MODULES = {"messaging": "Basilisk.architecture.messaging", "sysModel": "Basilisk.architecture.sysModel",
             "spacecraft": "Basilisk.simulation.spacecraft",
             "rw": "Basilisk.simulation.reactionWheelStateEffector",
             "gg": "Basilisk.simulation.GravityGradientEffector", "ext": "Basilisk.simulation.extForceTorque",
             "base": "Basilisk.utilities.SimulationBaseClass", "macros": "Basilisk.utilities.macros",
             "grav": "Basilisk.utilities.simIncludeGravBody", "rwf": "Basilisk.utilities.simIncludeRW",
+            "atmosphere": "Basilisk.simulation.exponentialAtmosphere", "wind": "Basilisk.simulation.zeroWindModel",
+            "drag": "Basilisk.simulation.dragDynamicEffector",
+            "field": "Basilisk.simulation.magneticFieldCenteredDipole", "mtb": "Basilisk.simulation.MtbEffector",
             "rbk": "Basilisk.utilities.RigidBodyKinematics", "helpers": "Basilisk.utilities.simHelpers"}
 _loaded: SimpleNamespace | None = None
 
@@ -112,7 +120,25 @@ def _module_class(bsk: SimpleNamespace):
                 payload.torqueRequestBody = [float(x) for x in torque]
                 self.cmdTorqueOutMsg.write(payload, CurrentSimNanos, self.moduleID)
 
-    return FlightModule
+    class EarthModule(bsk.sysModel.SysModel):
+        """Earth's orientation (staregen's GMST rotation) as the planet message the environment reads."""
+
+        def __init__(self, plant_step: float):
+            super().__init__()
+            self.plant_step, self.j = plant_step, 0
+            self.planetOutMsg = bsk.messaging.SpicePlanetStateMsg()
+
+        def Reset(self, CurrentSimNanos):   # noqa: N802, N803
+            self.j = 0
+
+        def UpdateState(self, CurrentSimNanos):   # noqa: N802, N803
+            payload = bsk.messaging.SpicePlanetStateMsgPayload()
+            payload.PlanetName = "earth"
+            payload.J20002Pfix = L_ei(*add_seconds(*SCENARIO_EPOCH, self.j * self.plant_step)).tolist()
+            self.j += 1
+            self.planetOutMsg.write(payload, CurrentSimNanos, self.moduleID)
+
+    return SimpleNamespace(flight=FlightModule, earth=EarthModule)
 
 
 # ----------------------------------------------------------------------------- staring scenario
@@ -153,6 +179,100 @@ class _StaringDrive:
             applied = (applied + self.cfg.errors.wheels.bias_array) + self.noise.wheels[j]
         self.rec_cmd[j] = self.cmd
         return applied
+
+
+def disturbance_names(cfg: SimConfig) -> list[str]:
+    """The disturbances a run of `cfg` has (both simulators: the same DisturbanceParams)."""
+    p = cfg.disturbances
+    if not cfg.external_torques:
+        return []
+    names = [name for name, on in (("gravity gradient", p.gravity_gradient), ("drag", p.drag_area > 0),
+                                   ("magnetic", bool(np.any(p.residual_dipole != 0))),
+                                   ("solar radiation", p.srp_area > 0)) if on]
+    return names
+
+
+def _add_disturbances(bsk, sim, task: str, sc, earth, cfg: SimConfig) -> list:
+    """Basilisk's effectors for the disturbances of cfg.disturbances; returns the Python-side objects that
+    must outlive the set-up (Basilisk keeps references to their messages only)."""
+    p, kept = cfg.disturbances, []
+    if p.srp_area > 0:
+        raise HostError("Basilisk here has no solar-radiation torque (it needs SPICE ephemerides); switch it off "
+                        "(srp_area = 0) on both sides")
+    if p.gravity_gradient:
+        gg = bsk.gg.GravityGradientEffector()
+        gg.ModelTag = sc.ModelTag
+        gg.addPlanetName(earth.planetName)
+        sc.addDynamicEffector(gg)
+        sim.AddModelToTask(task, gg, _PRIORITY["effectors"])
+        kept.append(gg)
+    if p.drag_area <= 0 and not np.any(p.residual_dipole != 0):
+        return kept
+    planet = _module_class(bsk).earth(cfg.plant_step)
+    planet.ModelTag = "staregen_earth"
+    sim.AddModelToTask(task, planet, _PRIORITY["earth"])
+    kept.append(planet)
+    if p.drag_area > 0:
+        kept += _add_drag(bsk, sim, task, sc, planet, p)
+    if np.any(p.residual_dipole != 0):
+        kept += _add_residual_dipole(bsk, sim, task, sc, planet, p)
+    return kept
+
+
+def _add_drag(bsk, sim, task: str, sc, planet, p) -> list:
+    """staregen's flat-plate drag: Basilisk's cannonball drag (the same formula, r_cp × F) in the band of
+    staregen's exponential table that holds the orbit, and the co-rotating air (zero wind)."""
+    h0, rho0, H = atmosphere_band(np.linalg.norm(orbit.table5_initial_state()[:3]) - WGS84_A)
+    atmosphere = bsk.atmosphere.ExponentialAtmosphere()
+    atmosphere.ModelTag = "staregen_atmosphere"
+    atmosphere.planetRadius, atmosphere.baseDensity, atmosphere.scaleHeight = float(WGS84_A + h0), float(rho0), float(H)
+    atmosphere.planetPosInMsg.subscribeTo(planet.planetOutMsg)
+    atmosphere.addSpacecraftToModel(sc.scStateOutMsg)
+    wind = bsk.wind.ZeroWindModel()
+    wind.ModelTag = "staregen_air"
+    wind.setPlanetOmega_N(earth_rate_vector(*SCENARIO_EPOCH).tolist())
+    wind.planetPosInMsg.subscribeTo(planet.planetOutMsg)
+    wind.addSpacecraftToModel(sc.scStateOutMsg)
+    drag = bsk.drag.DragDynamicEffector()
+    drag.ModelTag = "staregen_drag"
+    drag.coreParams.projectedArea = float(p.drag_area)
+    drag.coreParams.dragCoeff = float(p.drag_coefficient)
+    drag.coreParams.comOffset = [float(v) for v in p.drag_cp_offset]
+    drag.atmoDensInMsg.subscribeTo(atmosphere.envOutMsgs[0])
+    drag.windVelInMsg.subscribeTo(wind.envOutMsgs[0])
+    sc.addDynamicEffector(drag)
+    for model in (atmosphere, wind):
+        sim.AddModelToTask(task, model, _PRIORITY["environment"])
+    sim.AddModelToTask(task, drag, _PRIORITY["effectors"])
+    return [atmosphere, wind, drag]
+
+
+def _add_residual_dipole(bsk, sim, task: str, sc, planet, p) -> list:
+    """staregen's residual dipole in its tilted-dipole field: Basilisk's centred-dipole field with the same
+    IGRF-12 degree-1 coefficients on staregen's rotating Earth, and a torque-rod effector holding the dipole."""
+    field = bsk.field.MagneticFieldCenteredDipole()
+    field.ModelTag = "staregen_field"
+    g11, h11, g10 = (float(v) * 1e-9 for v in IGRF2015_DIPOLE_NT)
+    field.g10, field.g11, field.h11, field.planetRadius = g10, g11, h11, float(EARTH_RADIUS_DIPOLE)
+    field.planetPosInMsg.subscribeTo(planet.planetOutMsg)
+    field.addSpacecraftToModel(sc.scStateOutMsg)
+    config = bsk.messaging.MTBArrayConfigMsgPayload()
+    config.numMTB = 3
+    config.GtMatrix_B = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]
+    config.maxMtbDipoles = [1e9, 1e9, 1e9]
+    command = bsk.messaging.MTBCmdMsgPayload()
+    command.mtbDipoleCmds = [float(v) for v in p.residual_dipole]
+    config_msg = bsk.messaging.MTBArrayConfigMsg().write(config)
+    command_msg = bsk.messaging.MTBCmdMsg().write(command)
+    rods = bsk.mtb.MtbEffector()
+    rods.ModelTag = "staregen_residual_dipole"
+    rods.mtbParamsInMsg.subscribeTo(config_msg)
+    rods.mtbCmdInMsg.subscribeTo(command_msg)
+    rods.magInMsg.subscribeTo(field.envOutMsgs[0])
+    sc.addDynamicEffector(rods)
+    sim.AddModelToTask(task, field, _PRIORITY["environment"])
+    sim.AddModelToTask(task, rods, _PRIORITY["effectors"])
+    return [field, config_msg, command_msg, rods]
 
 
 def _wheel_inertia(cfg: SimConfig) -> float:
@@ -207,16 +327,11 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
     earth.isCentralBody = True
     earth.mu = MU_EARTH
     grav.addBodiesTo(sc)
-    if cfg.external_torques:
-        gg = bsk.gg.GravityGradientEffector()
-        gg.ModelTag = sc.ModelTag
-        gg.addPlanetName(earth.planetName)
-        sc.addDynamicEffector(gg)
-        sim.AddModelToTask(task, gg, _PRIORITY["wheels"])
+    kept = _add_disturbances(bsk, sim, task, sc, earth, cfg) if cfg.external_torques else []
 
     factory, rw = _add_wheels(bsk, sim, task, sc, cfg, omega0)
     drive = _StaringDrive(controller, lon, lat, cfg, stream, n)
-    module = _module_class(bsk)(drive, wheels=True)
+    module = _module_class(bsk).flight(drive, wheels=True)
     module.ModelTag = "staregen_flight"
     module.scStateInMsg.subscribeTo(sc.scStateOutMsg)
     rw.rwMotorCmdInMsg.subscribeTo(module.rwMotorTorqueOutMsg)
@@ -231,6 +346,7 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
     sim.InitializeSimulation()
     sim.ConfigureStopTime(_nanos(n * cfg.plant_step))
     sim.ExecuteSimulation()
+    del kept   # Basilisk holds only pointers to these Python objects and messages: alive until the run ends
     applied = -np.stack([np.array(w.u_current, float) for w in wheels], axis=1)   # body torque = −u_s
     return _staring_history(states, speeds, applied, drive, js, n, lon, lat, cfg, stream, bsk)
 
@@ -306,7 +422,7 @@ def tanh_run(law, period: float, duration: float, dt: float) -> dict:
     sim.AddModelToTask(task, ext, _PRIORITY["wheels"])
     law.reset()
     drive = _TanhDrive(law, sc, period, h, n_sub, n)
-    module = _module_class(bsk)(drive, wheels=False)
+    module = _module_class(bsk).flight(drive, wheels=False)
     module.ModelTag = "staregen_tanh"
     module.scStateInMsg.subscribeTo(body.scStateOutMsg)
     ext.cmdTorqueInMsg.subscribeTo(module.cmdTorqueOutMsg)

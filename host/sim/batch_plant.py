@@ -99,6 +99,7 @@ class Plant:
         r = np.sqrt(R @ R)
         r_hat_b = rows_dot_const(L_bi, R / r)
         gg = (3.0 * MU_EARTH / r ** 3) * cross(r_hat_b, const_matvec(self.inertia, r_hat_b))
+        gg = gg if p.gravity_gradient else 0.0 * gg
         v_b = rows_dot_const(L_bi, env.v_rel[j])
         speed = np.sqrt((v_b[0] * v_b[0] + v_b[1] * v_b[1]) + v_b[2] * v_b[2])
         drag = cross(p.drag_cp_offset, -0.5 * env.rho[j] * p.drag_coefficient * p.drag_area * speed * v_b)

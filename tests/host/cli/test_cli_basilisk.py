@@ -19,7 +19,7 @@ def test_fig2_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys)
     assert code == 0, err
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["scenario"]["simulator"] == f"Basilisk {basilisk.BSK_VERSION}"
-    assert metrics["scenario"]["disturbances"] == ["gravity gradient"]
+    assert metrics["scenario"]["disturbances"] == ["gravity gradient", "drag", "magnetic"]
     assert metrics["simulation"]["sensor_errors"] is False and metrics["J_A"] > 0
     check = json.loads((out / "crosscheck.json").read_text())
     assert check["per_target_within_2_percent"] is True
@@ -53,6 +53,8 @@ def _one_line_error(capsys, *argv) -> str:
     (["--controller", "pid"], "its controller flies its network; for --controller pid generate one with"),
     (["--duration", "-1"], "--duration"),
     (["--target", "500,0"], "target"),
+    (["--disturbances", "gravity-gradient,solar"], "--disturbances: unknown 'solar'"),
+    (["--controller", "tanh", "--disturbances", "none"], "--disturbances does not apply to --controller tanh"),
 ])
 def test_bad_arguments(flight_package, tmp_path, capsys, argv, message):
     err = _one_line_error(capsys, "--package", flight_package, *argv, "--out", tmp_path / "o")
