@@ -168,9 +168,10 @@ def run_staring(args, package, out: Path) -> int:
     with atomic.directory(out) as tmp:
         write_campaign(flown, tmp, described)
         if check is not None:
-            atomic.write_json(tmp / "crosscheck.json", {"simulators": ["staregen", described["simulator"]],
-                                                        "controller": args.controller, "errors": args.errors,
-                                                        **check.document()})
+            atomic.write_json(tmp / "crosscheck.json", {
+                "kind": "staring", "simulators": ["staregen", described["simulator"]], "controller": args.controller,
+                "errors": args.errors, "disturbances": described["disturbances"],
+                "duration_s": cfg.control_steps * cfg.control_period, **check.document()})
             a, b = own.histories[0], flown.histories[0]
             crosscheck.plot_overlay(a.t, [("A_bd [deg]", np.degrees(a.A_bd), np.degrees(b.A_bd)),
                                           ("omega_e [deg/s]", np.degrees(a.omega_e), np.degrees(b.omega_e))],
@@ -234,6 +235,10 @@ def run_tanh(args, package, out: Path) -> int:
         tanh_example.write_outputs(tmp, metrics, history)
         if reference is not None:
             ref = reference
+            atomic.write_json(tmp / "crosscheck.json", {
+                "kind": "tanh", "simulators": ["staregen", metrics["simulator"]], "controller": "tanh",
+                "duration_s": duration, "dt_s": dt, "u_max": metrics["u_max"], "torque_bound": bound,
+                "torque_within_bound": metrics["torque_within_bound"], **metrics["crosscheck"]})
             crosscheck.plot_overlay(history["t"], [("e", ref["e"], history["e"]), ("u [N*m]", ref["u"], history["u"])],
                                     tmp / "crosscheck_overlay.png",
                                     "tanh law, paper 000: staregen (solid) and Basilisk (dashed), the package's C in both")

@@ -1,6 +1,6 @@
-"""`staregen report [--evaluate DIR [--tune DIR]] [--rbf DIR ...] [--gp DIR ...] --out DIR`: report.md, the figures
-and one self-contained report.html of an evaluation (and a PID tuning, paper 002's and paper 004's runs), each
-table beside the paper's."""
+"""`staregen report [--evaluate DIR [--tune DIR]] [--rbf DIR ...] [--gp DIR ...] [--basilisk DIR ...] --out DIR`:
+report.md, the figures and one self-contained report.html of an evaluation (and a PID tuning, paper 002's and
+paper 004's runs, the Basilisk cross-checks), each table beside the paper's."""
 from __future__ import annotations
 
 import argparse
@@ -21,6 +21,9 @@ def register(subparsers) -> None:
     p.add_argument("--gp", dest="gp_dirs", action="append", default=[], metavar="DIR",
                    help="folder written by `staregen simulate --controller gp-baseline|gp` (adds paper 004's "
                         "section: baseline against the GP law, both starts; repeatable)")
+    p.add_argument("--basilisk", dest="basilisk_dirs", action="append", default=[], metavar="DIR",
+                   help="folder written by `staregen basilisk --compare` (adds the Basilisk cross-check: the table and "
+                        "the overlay plot; repeatable)")
     p.add_argument("--tune", default=None, metavar="DIR", help="folder written by `staregen tune pid`")
     p.add_argument("--calibration", default=None, metavar="DIR",
                    help="folder written by `staregen calibrate` (adds the section 'Fidelity to paper 001')")
@@ -35,8 +38,8 @@ def run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise HostError(f"output folder {out} exists and is not a directory")
-    if args.evaluate is None and not args.rbf_dirs and not args.gp_dirs:
-        raise HostError("give --evaluate DIR, --rbf DIR, --gp DIR or several")
+    if args.evaluate is None and not args.rbf_dirs and not args.gp_dirs and not args.basilisk_dirs:
+        raise HostError("give --evaluate DIR, --rbf DIR, --gp DIR, --basilisk DIR or several")
     evaluate_dir = Path(args.evaluate) if args.evaluate is not None else None
     if evaluate_dir is not None and not evaluate_dir.is_dir():
         raise HostError(f"--evaluate {evaluate_dir}: not a folder")
@@ -48,6 +51,10 @@ def run(args: argparse.Namespace) -> int:
     for d in gp_dirs:
         if not d.is_dir():
             raise HostError(f"--gp {d}: not a folder")
+    basilisk_dirs = [Path(d) for d in args.basilisk_dirs]
+    for d in basilisk_dirs:
+        if not d.is_dir():
+            raise HostError(f"--basilisk {d}: not a folder")
     tune_dir = Path(args.tune) if args.tune else None
     if tune_dir is not None and not tune_dir.is_dir():
         raise HostError(f"--tune {tune_dir}: not a folder")
@@ -56,6 +63,6 @@ def run(args: argparse.Namespace) -> int:
         raise HostError(f"--calibration {cal_dir}: not a folder")
     if evaluate_dir is None and (tune_dir is not None or cal_dir is not None):
         raise HostError("--tune and --calibration need --evaluate")
-    paths = write_report(out, evaluate_dir, tune_dir, args.commands, cal_dir, rbf_dirs, gp_dirs)
+    paths = write_report(out, evaluate_dir, tune_dir, args.commands, cal_dir, rbf_dirs, gp_dirs, basilisk_dirs)
     print(f"wrote {paths['md']} and {paths['html']}")
     return 0

@@ -370,16 +370,61 @@ def gp_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
     return out
 
 
+def _e(x) -> str:
+    return f"{x:.4g}" if isinstance(x, (int, float)) and not isinstance(x, bool) else "-"
+
+
+def basilisk_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
+    """`staregen basilisk --compare`: the package's C in Basilisk beside the same C in staregen's simulator."""
+    out = [Block("h2", "The flight package in Basilisk, beside staregen's simulator (issue 28)")]
+    staring = [r for r in runs if r["kind"] == "staring"]
+    if staring:
+        rows = []
+        for r in staring:
+            mean = r.get("means", {})
+            a = mean.get("J_A") or {"staregen": r["targets"][0]["staregen"]["J_A"],
+                                    "basilisk": r["targets"][0]["basilisk"]["J_A"]}
+            w = mean.get("J_w") or {"staregen": r["targets"][0]["staregen"]["J_w"],
+                                    "basilisk": r["targets"][0]["basilisk"]["J_w"]}
+            verdict = "within 2 %" if r["per_target_within_2_percent"] else "NOT within 2 %"
+            if "means_within_spread" in r:
+                verdict += "; means " + ("within" if r["means_within_spread"] else "NOT within") + " their spread"
+            rows.append((r["controller"], r["errors"], ", ".join(r["disturbances"]) or "none", str(len(r["targets"])),
+                         f"{_e(a['staregen'])} / {_e(a['basilisk'])}", f"{_e(w['staregen'])} / {_e(w['basilisk'])}",
+                         f"{_e(r['max_relative_difference']['J_A'])}, {_e(r['max_relative_difference']['J_w'])}",
+                         _e(r["max_attitude_diff_deg"]), verdict))
+        out += [Block("table", header=("controller", "errors", "disturbances", "targets",
+                                       "J_A staregen / Basilisk [°]", "J_ω staregen / Basilisk [°/s]",
+                                       "max relative difference J_A, J_ω", "max |ΔA_bd| [°]", "verdict"),
+                      rows=tuple(rows)),
+                Block("p", "Both simulators fly the package's object code from the same initial state with the same "
+                           "noise draws; J over several targets is their mean (docs/basilisk.md).")]
+    for r in (r for r in runs if r["kind"] == "tanh"):
+        out.append(Block("p", f"Paper 000's tanh law: settling time {_e(r['t_settle_basilisk'])} s in Basilisk against "
+                              f"{_e(r['t_settle_staregen'])} s in staregen's simulator (relative difference "
+                              f"{_e(r['relative_difference'])}, tolerance ±{r['tolerance']:.0%}: "
+                              + ("within" if r["within"] else "NOT within") + f"); max |u| {_e(r['u_max'])} N·m against "
+                              f"its bound {_e(r['torque_bound'])} N·m."))
+    for name, path in figures.items():
+        run, _, _ = name.partition("_")
+        r = runs[int(run) - 1]
+        out.append(Block("img", text=f"run {run} ({r['controller']}): staregen (solid) and Basilisk (dashed), and "
+                                     "their difference", path=str(path)))
+    return out
+
+
 def build(evaluation: dict | None, tuning: dict | None, figures: dict[str, Path], run_facts: dict,
           calibration: dict | None = None, calibration_figure: Path | None = None,
           rbf_runs: list[dict] = (), rbf_figures: dict[str, Path] | None = None,
-          gp_runs: list[dict] = (), gp_figures: dict[str, Path] | None = None) -> list[Block]:
+          gp_runs: list[dict] = (), gp_figures: dict[str, Path] | None = None,
+          basilisk_runs: list[dict] = (), basilisk_figures: dict[str, Path] | None = None) -> list[Block]:
     title = "staregen: tuning and evaluation against paper 001 §7" if evaluation else "staregen report"
     blocks = [Block("h1", title)]
     facts = ", ".join(f"{k} {v}" for k, v in run_facts.items())
     blocks.append(Block("p", f"Run: {facts}."))
     if evaluation is None:
-        return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures)
+        return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures) \
+            + _basilisk(basilisk_runs, basilisk_figures)
     plan = evaluation.get("plan")
     if plan:
         blocks.append(Block("p", f"Evaluation plan: {plan['targets']} staring targets × {plan['duration']:g} s, step "
@@ -429,7 +474,11 @@ def build(evaluation: dict | None, tuning: dict | None, figures: dict[str, Path]
     blocks.append(Block("h2", "Figures"))
     for name, path in figures.items():
         blocks.append(Block("img", text=captions.get(name, name), path=str(path)))
-    return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures)
+    return blocks + _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures) + _basilisk(basilisk_runs, basilisk_figures)
+
+
+def _basilisk(runs, figures) -> list[Block]:
+    return basilisk_blocks(list(runs), figures or {}) if runs else []
 
 
 def _paper_blocks(rbf_runs, rbf_figures, gp_runs, gp_figures) -> list[Block]:
@@ -488,6 +537,7 @@ PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 MAX_FIGURE_BYTES = 64 << 20
 FIGURES = ("fig10_scatter.png", "fig11_12_step.png", "fig13_14_frequency.png", "fig15_impulse.png")
 RBF_FIGURES = ("fig_range_los.png", "fig_attitude.png", "fig_rbf_estimate.png", "fig_c_vs_float64.png")
+BASILISK_FIGURES = ("crosscheck_overlay.png",)
 GP_FIGURES = ("fig4_attitude.png", "fig5_rates.png", "fig6_torque.png", "fig7_variance_gains.png", "fig_gp_mean.png")
 
 
@@ -511,7 +561,7 @@ def _read_figure(path: Path) -> bytes | None:
 
 
 def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_dir: Path | None,
-                 rbf_dirs: list[Path] = (), gp_dirs: list[Path] = ()) -> dict:
+                 rbf_dirs: list[Path] = (), gp_dirs: list[Path] = (), basilisk_dirs: list[Path] = ()) -> dict:
     """Every input of the report, checked, before anything is written (the documents first)."""
     return {
         "evaluation": documents.read(evaluate_dir / "evaluate.json", "evaluation (evaluate.json)",
@@ -524,6 +574,9 @@ def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_d
                               "staregen simulate --controller gp-baseline|gp|gp-c|gp-arm") for d in gp_dirs],
         "gp_figures": {f"{i + 1}_{name}": data for i, d in enumerate(gp_dirs) for name in GP_FIGURES
                        if (data := _read_figure(d / name)) is not None},
+        "basilisk": [documents.read_basilisk(d / "crosscheck.json") for d in basilisk_dirs],
+        "basilisk_figures": {f"{i + 1}_{name}": data for i, d in enumerate(basilisk_dirs) for name in BASILISK_FIGURES
+                             if (data := _read_figure(d / name)) is not None},
         "tuning": documents.read(tune_dir / "result.json", "tuning result (result.json)", documents.TUNING,
                                  "staregen tune pid") if tune_dir else None,
         "calibration": documents.read(calibration_dir / "calibration.json", "calibration (calibration.json)",
@@ -536,13 +589,15 @@ def _read_inputs(evaluate_dir: Path | None, tune_dir: Path | None, calibration_d
 
 def write_report(out: Path, evaluate_dir: Path | None, tune_dir: Path | None, commands: list[str],
                  calibration_dir: Path | None = None, rbf_dirs: list[Path] = (),
-                 gp_dirs: list[Path] = ()) -> dict[str, Path]:
-    inputs = _read_inputs(evaluate_dir, tune_dir, calibration_dir, rbf_dirs, gp_dirs)
+                 gp_dirs: list[Path] = (), basilisk_dirs: list[Path] = ()) -> dict[str, Path]:
+    inputs = _read_inputs(evaluate_dir, tune_dir, calibration_dir, rbf_dirs, gp_dirs, basilisk_dirs)
     evaluation, tuning, calibration = inputs["evaluation"], inputs["tuning"], inputs["calibration"]
     out.mkdir(parents=True, exist_ok=True)
     figures = {name: atomic.write_bytes(out / name, data) for name, data in inputs["figures"].items()}
     rbf_figures = {name: atomic.write_bytes(out / f"rbf{name}", data) for name, data in inputs["rbf_figures"].items()}
     gp_figures = {name: atomic.write_bytes(out / f"gp{name}", data) for name, data in inputs["gp_figures"].items()}
+    basilisk_figures = {name: atomic.write_bytes(out / f"basilisk{name}", data)
+                        for name, data in inputs["basilisk_figures"].items()}
     cal_figure = None
     if inputs["calibration_figure"] is not None:
         cal_figure = atomic.write_bytes(out / "fig_ratio_vs_noise.png", inputs["calibration_figure"])
@@ -555,7 +610,7 @@ def write_report(out: Path, evaluate_dir: Path | None, tune_dir: Path | None, co
     if commands:
         facts["commands"] = "; ".join(commands)
     blocks = build(evaluation, tuning, figures, facts, calibration, cal_figure, inputs["rbf"], rbf_figures,
-                   inputs["gp"], gp_figures)
+                   inputs["gp"], gp_figures, inputs["basilisk"], basilisk_figures)
     paths = {"md": atomic.write_text(out / "report.md", to_markdown(blocks)),
              "html": atomic.write_text(out / "report.html", to_html(blocks))}
     return paths

@@ -93,6 +93,25 @@ GP_RUN = {
     "max_mu_diff?": NONNEG, "cycles_median?": COUNT, "cycles_max?": COUNT,
 }
 GP_IN_LOOP = ("mode", "golden_mismatch_steps", "max_angle_diff_deg", "max_torque_diff", "max_mu_diff")  # all or none
+# `staregen basilisk --compare` (host.cli.basilisk): crosscheck.json of the staring scenario and of paper 000's
+BASILISK_SIMULATORS = ListOf(TEXT, 2)
+BASILISK_STARING = {
+    "kind": TEXT, "simulators": BASILISK_SIMULATORS, "controller": TEXT, "errors": TEXT, "disturbances": ListOf(TEXT),
+    "duration_s": POSITIVE, "targets": ListOf({"staregen": {"J_A": NONNEG, "J_w": NONNEG},
+                                                 "basilisk": {"J_A": NONNEG, "J_w": NONNEG}}, min_length=1),
+    "max_attitude_diff_deg": NONNEG, "max_rate_diff_deg_s": NONNEG,
+    "max_relative_difference": {"J_A": NONNEG, "J_w": NONNEG}, "per_target_within_2_percent": FLAG,
+    "means?": MapOf({"staregen": NONNEG, "basilisk": NONNEG, "standard_error": NONNEG,
+                     "difference_in_standard_errors": NONNEG}),
+    "means_within_spread?": FLAG,
+}
+BASILISK_TANH = {
+    "kind": TEXT, "simulators": BASILISK_SIMULATORS, "controller": TEXT, "duration_s": POSITIVE, "dt_s": POSITIVE,
+    "u_max": NONNEG, "torque_bound": POSITIVE, "torque_within_bound": FLAG, "t_settle_staregen": MAYBE_TIME,
+    "t_settle_basilisk": MAYBE_TIME, "relative_difference": Maybe(REAL), "tolerance": POSITIVE, "within": FLAG,
+    "max_abs_e_norm_difference": NONNEG,
+}
+
 # the names host.sim.gp_example writes (tests/host/tune/test_report.py checks they agree)
 GP_CONTROLLERS = ("gp-baseline", "gp", "gp-c", "gp-arm")
 GP_STARTS = ("capture", "outside")
@@ -191,6 +210,20 @@ def _check_gp_run(doc: dict) -> None:
         for key in ("var_fraction_first_60s", "var_fraction_last_60s"):
             if doc[key] is None:
                 raise HostError(f"{key}: a GP law's run must give it, got null")
+
+
+def read_basilisk(path: Path) -> dict:
+    """crosscheck.json of `staregen basilisk --compare`, of either kind, checked (one line otherwise)."""
+    what, writer = "Basilisk cross-check (crosscheck.json)", "staregen basilisk --compare"
+    doc = read(path, what, {"kind": TEXT}, writer)
+    shape = {"staring": BASILISK_STARING, "tanh": BASILISK_TANH}.get(doc["kind"])
+    try:
+        if shape is None:
+            raise HostError(f"kind: expected 'staring' or 'tanh', got {_label(doc['kind'])}")
+        check(doc, shape, "")
+    except HostError as exc:
+        raise HostError(f"{path}: not written by `{writer}`: {exc}") from None
+    return doc
 
 
 def _refuse_constant(name: str):

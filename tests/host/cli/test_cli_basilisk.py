@@ -27,6 +27,17 @@ def test_fig2_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys)
     for name in ("history.npz", "euler_error.png", "rate_error.png", "crosscheck_overlay.png"):
         assert (out / name).stat().st_size > 0
     assert "cross-check, Basilisk against staregen's simulator" in stdout and "within" in stdout
+    assert check["kind"] == "staring" and check["disturbances"] == ["gravity gradient", "drag", "magnetic"]
+    # the report's section: the table row and the overlay plot
+    code, _, err = cli(capsys, "report", "--basilisk", out, "--out", tmp_path / "report")
+    assert code == 0, err
+    md = (tmp_path / "report" / "report.md").read_text()
+    assert "The flight package in Basilisk, beside staregen's simulator" in md
+    assert f"| fig2 | off | gravity gradient, drag, magnetic | 1 | {check['targets'][0]['staregen']['J_A']:.4g} / " in md
+    assert "(basilisk1_crosscheck_overlay.png)" in md and (tmp_path / "report" / "basilisk1_crosscheck_overlay.png").exists()
+    (out / "crosscheck.json").write_text(json.dumps({**check, "kind": "ramp"}))
+    code, _, err = cli(capsys, "report", "--basilisk", out, "--out", tmp_path / "report2")
+    assert code == 2 and "kind: expected 'staring' or 'tanh', got 'ramp'" in err and len(err.strip().splitlines()) == 1
 
 
 def test_tanh_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys):
@@ -38,6 +49,11 @@ def test_tanh_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys)
     assert m["torque_within_bound"] is True and m["torque_bound"] == 4.5
     assert m["crosscheck"]["within"] is True and abs(m["crosscheck"]["relative_difference"]) < 0.05
     assert (out / "crosscheck_overlay.png").stat().st_size > 0
+    check = json.loads((out / "crosscheck.json").read_text())
+    assert check["kind"] == "tanh" and check["within"] is True
+    code, _, err = cli(capsys, "report", "--basilisk", out, "--out", tmp_path / "report")
+    assert code == 0, err
+    assert "Paper 000's tanh law: settling time" in (tmp_path / "report" / "report.md").read_text()
 
 
 def _one_line_error(capsys, *argv) -> str:

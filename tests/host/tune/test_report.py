@@ -187,7 +187,7 @@ def test_the_rbf_section_puts_paper_002_beside_each_run(tmp_path):
 
 def test_bad_rbf_inputs_are_one_line(tmp_path, capsys):
     assert main(["report", "--out", str(tmp_path / "r")]) == 2
-    assert "give --evaluate DIR, --rbf DIR, --gp DIR or several" in capsys.readouterr().err
+    assert "give --evaluate DIR, --rbf DIR, --gp DIR, --basilisk DIR or several" in capsys.readouterr().err
     assert main(["report", "--rbf", str(tmp_path / "none"), "--out", str(tmp_path / "r")]) == 2
     assert "--rbf" in capsys.readouterr().err
     bad = _rbf_run(tmp_path / "bad", t_rho_5m="soon")
