@@ -141,12 +141,13 @@ class FlightPackage:
         return PackageEntry(self, kind, records)
 
 
-def load_package(folder: str | Path) -> FlightPackage:
-    """Check, compile and self-test the package in `folder`; ToolError (one line) if any step fails."""
+def load_package(folder: str | Path, key: bytes | None = None) -> FlightPackage:
+    """Check (with `key`: its HMAC-SHA256 signature too), compile and self-test the package in `folder`;
+    ToolError (one line) if any step fails."""
     folder = Path(folder)
     if not folder.is_dir():
         raise ToolError(f"package {folder}: no such folder")
-    doc, problems = manifest.check(folder)
+    doc, problems = manifest.check(folder, key)
     if problems:
         raise ToolError(f"package {folder} fails its check, not loaded: {problems[0]}")
     name = doc.get("name")

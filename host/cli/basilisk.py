@@ -21,6 +21,7 @@ import numpy as np
 
 from codegen import atomic
 from codegen import units as unit_registry
+from codegen.package.manifest import load_key
 from codegen.units.tanh.unit import TanhUnit
 from host.cli.args import add_scenario_argument, load_scenario, parse_int, parse_number, shown
 from host.cli.simulate import MAX_DURATION_S, build_plan
@@ -67,6 +68,9 @@ def register(subparsers) -> None:
     p.add_argument("--dt", default=None, help=f"tanh only: plant step in s (default {TANH_DEFAULT_DT:g}, as "
                    "`simulate --controller tanh-c`)")
     p.add_argument("--workers", default=None, help="worker processes for several targets (default: all cores)")
+    p.add_argument("--verify-key", default=None, metavar="FILE",
+                   help="the package's manifest must carry a valid HMAC-SHA256 signature under this key "
+                        "(`generate --sign-key FILE`), else it is not loaded")
     p.add_argument("--compare", action="store_true",
                    help="also fly the same package in staregen's simulator and write the cross-check")
     p.add_argument("--out", default="out/basilisk", help="output folder (default out/basilisk)")
@@ -92,9 +96,10 @@ def _check_arguments(args) -> None:
 def main(args: argparse.Namespace) -> int:
     _check_arguments(args)
     out = Path(args.out)
-    check_output_folder(out, OWNED, [args.package, args.scenario])
+    check_output_folder(out, OWNED, [args.package, args.scenario, args.verify_key])
+    key = load_key(args.verify_key) if args.verify_key is not None else None
     basilisk.basilisk()                          # a missing extra: one line, before anything is built
-    package = loaded_package(str(Path(args.package)))   # checked, built, self-tested; else one line
+    package = loaded_package(str(Path(args.package)), key)   # checked, built, self-tested; else one line
     if args.controller == "tanh":
         return run_tanh(args, package, out)
     return run_staring(args, package, out)
@@ -155,7 +160,7 @@ def run_staring(args, package, out: Path) -> int:
     plan.windows(cfg.control_steps * cfg.control_period)
     check_targets_visible(targets, cfg)
     workers = None if args.workers is None else parse_int(args.workers, "--workers", minimum=1)
-    make = functools.partial(make_package_controller, str(Path(args.package)), args.controller)
+    make = functools.partial(make_package_controller, str(Path(args.package)), args.controller, key)
     described = {**scenario.describe(), "simulator": f"Basilisk {basilisk.BSK_VERSION}",
                  "package": package.name, "disturbances": basilisk.disturbance_names(cfg)}
     print(f"{args.controller}: package {package.name} in Basilisk {basilisk.BSK_VERSION}, {len(targets)} target(s), "

@@ -21,20 +21,20 @@ CONTROLLER_RECORDS = Records(controller_records.INPUT_DTYPE, controller_records.
 TANH_RECORDS = Records(tanh_records.INPUT_DTYPE, tanh_records.OUTPUT_DTYPE, tanh_records.STATE_DTYPE)
 
 
-_loaded: dict[str, FlightPackage] = {}
+_loaded: dict[tuple[str, bytes | None], FlightPackage] = {}
 
 
-def loaded_package(folder: str) -> FlightPackage:
-    """The package in `folder`, checked, built and self-tested once per process (worker processes
-    of a many-target run each load it once)."""
-    if folder not in _loaded:
-        _loaded[folder] = load_package(folder)
-    return _loaded[folder]
+def loaded_package(folder: str, key: bytes | None = None) -> FlightPackage:
+    """The package in `folder`, checked (its signature under `key`, when given), built and self-tested
+    once per process (worker processes of a many-target run each load it once)."""
+    if (folder, key) not in _loaded:
+        _loaded[(folder, key)] = load_package(folder, key)
+    return _loaded[(folder, key)]
 
 
-def make_package_controller(folder: str, name: str = "fig2") -> "PackageController":
+def make_package_controller(folder: str, name: str = "fig2", key: bytes | None = None) -> "PackageController":
     """A picklable factory (functools.partial of it) for host.sim.simulator.simulate_targets."""
-    return PackageController(loaded_package(folder), name)
+    return PackageController(loaded_package(folder, key), name)
 
 
 def pid_only(package: FlightPackage) -> bool:

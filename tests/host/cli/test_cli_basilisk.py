@@ -97,6 +97,14 @@ def test_a_manifest_without_a_usable_period_is_one_line(flight_package, tmp_path
     assert "config.timing.control_period is not a period" in err
 
 
+def test_an_unsigned_package_under_a_key_is_never_loaded(flight_package, tmp_path, capsys, monkeypatch):
+    key = tmp_path / "key.bin"
+    key.write_bytes(bytes(range(32)))
+    monkeypatch.setattr(x86, "build", lambda *a, **k: pytest.fail("an unverified package was compiled"))
+    err = _one_line_error(capsys, "--package", flight_package, "--verify-key", key, "--out", tmp_path / "o")
+    assert "fails its check, not loaded: signature: the manifest is not signed" in err
+
+
 def test_a_missing_extra_is_one_line(flight_package, tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(basilisk, "_loaded", None)
     monkeypatch.setitem(basilisk._MODULES, "spacecraft", "Basilisk.simulation.no_such_module")
