@@ -102,7 +102,7 @@ def main(args: argparse.Namespace) -> int:
     package = loaded_package(str(Path(args.package)), key)   # checked, built, self-tested; else one line
     if args.controller == "tanh":
         return run_tanh(args, package, out)
-    return run_staring(args, package, out)
+    return run_staring(args, package, out, key)
 
 
 # ----------------------------------------------------------------------------- staring scenario
@@ -152,7 +152,7 @@ def _campaign(name, targets, cfg, plan, make, workers, engine) -> CampaignResult
                           time.perf_counter() - start)
 
 
-def run_staring(args, package, out: Path) -> int:
+def run_staring(args, package, out: Path, key: bytes | None = None) -> int:
     _check_controller(package, args.controller, args.package)
     scenario = load_scenario(args.scenario)
     cfg, plan = staring_config(args, scenario), build_plan(args)
