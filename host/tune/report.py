@@ -370,8 +370,8 @@ def gp_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
     return out
 
 
-def _e(x) -> str:
-    return f"{x:.4g}" if isinstance(x, (int, float)) and not isinstance(x, bool) else "-"
+def _e(x, digits: int = 4) -> str:
+    return f"{x:.{digits}g}" if isinstance(x, (int, float)) and not isinstance(x, bool) else "-"
 
 
 def basilisk_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
@@ -390,7 +390,7 @@ def basilisk_blocks(runs: list[dict], figures: dict[str, Path]) -> list[Block]:
             if "means_within_spread" in r:
                 verdict += "; means " + ("within" if r["means_within_spread"] else "NOT within") + " their spread"
             rows.append((r["controller"], r["errors"], ", ".join(r["disturbances"]) or "none", str(len(r["targets"])),
-                         f"{_e(a['staregen'])} / {_e(a['basilisk'])}", f"{_e(w['staregen'])} / {_e(w['basilisk'])}",
+                         f"{_e(a['staregen'], 7)} / {_e(a['basilisk'], 7)}", f"{_e(w['staregen'], 7)} / {_e(w['basilisk'], 7)}",
                          f"{_e(r['max_relative_difference']['J_A'])}, {_e(r['max_relative_difference']['J_w'])}",
                          _e(r["max_attitude_diff_deg"]), verdict))
         out += [Block("table", header=("controller", "errors", "disturbances", "targets",

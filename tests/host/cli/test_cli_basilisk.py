@@ -33,7 +33,7 @@ def test_fig2_in_basilisk_with_the_cross_check(flight_package, tmp_path, capsys)
     assert code == 0, err
     md = (tmp_path / "report" / "report.md").read_text()
     assert "The flight package in Basilisk, beside staregen's simulator" in md
-    assert f"| fig2 | off | gravity gradient, drag, magnetic | 1 | {check['targets'][0]['staregen']['J_A']:.4g} / " in md
+    assert f"| fig2 | off | gravity gradient, drag, magnetic | 1 | {check['targets'][0]['staregen']['J_A']:.7g} / " in md
     assert "(basilisk1_crosscheck_overlay.png)" in md and (tmp_path / "report" / "basilisk1_crosscheck_overlay.png").exists()
     (out / "crosscheck.json").write_text(json.dumps({**check, "kind": "ramp"}))
     code, _, err = cli(capsys, "report", "--basilisk", out, "--out", tmp_path / "report2")
