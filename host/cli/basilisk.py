@@ -91,6 +91,8 @@ def _check_arguments(args) -> None:
             raise HostError(f"{staring_only[0][0]} does not apply to --controller tanh (paper 000's own example)")
     elif args.dt is not None:
         raise HostError("--dt applies to --controller tanh only (the staring scenario steps at 0.02 s)")
+    else:
+        parse_disturbances(args.disturbances)      # refused before Basilisk is imported or the package built
 
 
 def main(args: argparse.Namespace) -> int:

@@ -297,7 +297,8 @@ def _add_wheels(bsk, sim, task: str, sc, cfg: SimConfig, omega0: np.ndarray):
 
 def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig = SimConfig(), stream: int = 0) -> History:
     """Fly `controller` (stepped at the control period) staring at (lon, lat) in Basilisk; the
-    signature of host.sim.simulator.simulate (cfg.external_torques switches the gravity gradient)."""
+    signature of host.sim.simulator.simulate (cfg.external_torques and cfg.disturbances choose the
+    disturbances, as in staregen's simulator)."""
     bsk = basilisk()
     sub, n_ctrl = cfg.substeps, cfg.control_steps
     n = n_ctrl * sub

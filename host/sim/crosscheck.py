@@ -38,9 +38,10 @@ class CrossCheck:
         a = np.array([getattr(m, key) for m in self.staregen])
         b = np.array([getattr(m, key) for m in self.basilisk])
         n = len(a)
-        se = float(np.std(a, ddof=1) / np.sqrt(n)) if n > 1 else float("nan")
+        se = float(np.std(a, ddof=1) / np.sqrt(n)) if n > 1 else 0.0
+        diff = float(abs(np.mean(b) - np.mean(a)))
         return {"staregen": float(np.mean(a)), "basilisk": float(np.mean(b)), "standard_error": se,
-                "difference_in_standard_errors": float(abs(np.mean(b) - np.mean(a)) / se) if n > 1 else None}
+                "difference_in_standard_errors": diff / se if se > 0 else None, "difference": diff}
 
     def verdict(self) -> dict:
         worst = {k: float(np.max(np.abs(self.relative(k)))) for k in ("J_A", "J_w")}
@@ -49,8 +50,9 @@ class CrossCheck:
         if len(self.staregen) > 1:
             means = {k: self.means(k) for k in ("J_A", "J_w")}
             out["means"] = means
-            out["means_within_spread"] = bool(all(m["difference_in_standard_errors"] <= SPREAD_TOLERANCE
-                                                  for m in means.values()))
+            out["means_within_spread"] = bool(all(
+                m["difference"] == 0.0 if m["difference_in_standard_errors"] is None
+                else m["difference_in_standard_errors"] <= SPREAD_TOLERANCE for m in means.values()))
         return out
 
     def document(self) -> dict:
@@ -79,8 +81,10 @@ def summary_lines(c: CrossCheck) -> list[str]:
         a, b = c.staregen[0], c.basilisk[0]
         lines.append(f"  J_A {a.J_A:.6e} / {b.J_A:.6e} deg, J_w {a.J_w:.6e} / {b.J_w:.6e} deg/s (staregen / Basilisk)")
     for key, m in v.get("means", {}).items():
+        spread = "no spread" if m["difference_in_standard_errors"] is None else \
+            f"difference {m['difference_in_standard_errors']:.3f} standard errors"
         lines.append(f"  mean {key} {m['staregen']:.6e} / {m['basilisk']:.6e} (staregen / Basilisk), standard error "
-                     f"{m['standard_error']:.2e}: difference {m['difference_in_standard_errors']:.3f} standard errors")
+                     f"{m['standard_error']:.2e}: {spread}")
     if "means_within_spread" in v:
         lines.append("  means " + ("within" if v["means_within_spread"] else "NOT within") + " their spread")
     return lines

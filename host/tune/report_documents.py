@@ -102,7 +102,7 @@ BASILISK_STARING = {
     "max_attitude_diff_deg": NONNEG, "max_rate_diff_deg_s": NONNEG,
     "max_relative_difference": {"J_A": NONNEG, "J_w": NONNEG}, "per_target_within_2_percent": FLAG,
     "means?": MapOf({"staregen": NONNEG, "basilisk": NONNEG, "standard_error": NONNEG,
-                     "difference_in_standard_errors": NONNEG}),
+                     "difference_in_standard_errors": Maybe(NONNEG)}),
     "means_within_spread?": FLAG,
 }
 BASILISK_TANH = {

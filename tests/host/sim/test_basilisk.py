@@ -14,7 +14,8 @@ from host.core.vec3 import dcm_from_quat3
 from host.errors import HostError
 from host.plant.disturbances import DisturbanceParams
 from host.sim import basilisk, tanh_example, tanh_in_loop
-from host.sim.metrics import DEFAULT_PLAN, staring_metrics
+from host.sim.crosscheck import CrossCheck
+from host.sim.metrics import DEFAULT_PLAN, StaringMetrics, staring_metrics
 from host.sim.simulator import SimConfig, simulate
 from host.sim.targets import central_target
 from tools.package_lib import load_package
@@ -113,3 +114,21 @@ def test_the_tanh_package_converges_alike_in_both_simulators(package):
     assert ts is not None and tb is not None and abs(tb - ts) <= 0.05 * ts
     assert np.max(np.abs(theirs["u"])) <= 4.5                      # k1 + k2 + k3 of paper 000
     assert np.max(np.abs(np.linalg.norm(theirs["e"], axis=1) - np.linalg.norm(ours["e"], axis=1))) < 1e-2
+
+
+def test_means_without_spread_are_judged_on_their_difference():
+    """Two identical targets: no spread (standard error 0); the means agree only if equal (no inf/NaN)."""
+    same = [StaringMetrics(J_A=1e-4, J_w=1e-5, J=1.5e-4)] * 2
+    check = cross_check_of(same, same)
+    assert check.verdict()["means_within_spread"] is True
+    assert check.means("J_A")["difference_in_standard_errors"] is None
+    other = [StaringMetrics(J_A=1.01e-4, J_w=1e-5, J=1.5e-4)] * 2
+    assert cross_check_of(same, other).verdict()["means_within_spread"] is False
+    many = [StaringMetrics(J_A=a, J_w=1e-5, J=a) for a in (1e-4, 2e-4, 3e-4)]
+    shifted = [StaringMetrics(J_A=a + 1e-5, J_w=1e-5, J=a) for a in (1e-4, 2e-4, 3e-4)]
+    m = cross_check_of(many, shifted).means("J_A")     # SE = 1e-4/sqrt(3): 1e-5 is 0.173 of it
+    assert abs(m["difference_in_standard_errors"] - 1e-5 / (1e-4 / np.sqrt(3))) < 1e-9
+
+
+def cross_check_of(a, b):
+    return CrossCheck(a, b, 0.0, 0.0)
