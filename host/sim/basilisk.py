@@ -141,6 +141,21 @@ def _module_class(bsk: SimpleNamespace):
     return SimpleNamespace(flight=FlightModule, earth=EarthModule)
 
 
+def _flight_module(bsk, sim, task: str, drive: Callable, body, wheels: bool, tag: str):
+    """The flight module reading `body`'s state, in the task after the dynamics and before the actuators."""
+    module = _module_class(bsk).flight(drive, wheels=wheels)
+    module.ModelTag = tag
+    module.scStateInMsg.subscribeTo(body.scStateOutMsg)
+    sim.AddModelToTask(task, module, _PRIORITY["flight"])
+    return module
+
+
+def _execute(sim, seconds: float) -> None:
+    sim.InitializeSimulation()
+    sim.ConfigureStopTime(_nanos(seconds))
+    sim.ExecuteSimulation()
+
+
 # ----------------------------------------------------------------------------- staring scenario
 
 class _StaringDrive:
@@ -332,11 +347,8 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
 
     factory, rw = _add_wheels(bsk, sim, task, sc, cfg, omega0)
     drive = _StaringDrive(controller, lon, lat, cfg, stream, n)
-    module = _module_class(bsk).flight(drive, wheels=True)
-    module.ModelTag = "staregen_flight"
-    module.scStateInMsg.subscribeTo(sc.scStateOutMsg)
+    module = _flight_module(bsk, sim, task, drive, sc, wheels=True, tag="staregen_flight")
     rw.rwMotorCmdInMsg.subscribeTo(module.rwMotorTorqueOutMsg)
-    sim.AddModelToTask(task, module, _PRIORITY["flight"])
     states = sc.scStateOutMsg.recorder()
     speeds = rw.rwSpeedOutMsg.recorder()
     wheels = [rw.rwOutMsgs[i].recorder() for i in range(3)]   # u_current: the torque Basilisk applies
@@ -344,9 +356,7 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
         sim.AddModelToTask(task, recorder, _PRIORITY["recorders"])
 
     controller.reset()
-    sim.InitializeSimulation()
-    sim.ConfigureStopTime(_nanos(n * cfg.plant_step))
-    sim.ExecuteSimulation()
+    _execute(sim, n * cfg.plant_step)
     del kept   # Basilisk holds only pointers to these Python objects and messages: alive until the run ends
     applied = -np.stack([np.array(w.u_current, float) for w in wheels], axis=1)   # body torque = −u_s
     return _staring_history(states, speeds, applied, drive, js, n, lon, lat, cfg, stream, bsk)
@@ -423,16 +433,11 @@ def tanh_run(law, period: float, duration: float, dt: float) -> dict:
     sim.AddModelToTask(task, ext, _PRIORITY["wheels"])
     law.reset()
     drive = _TanhDrive(law, sc, period, h, n_sub, n)
-    module = _module_class(bsk).flight(drive, wheels=False)
-    module.ModelTag = "staregen_tanh"
-    module.scStateInMsg.subscribeTo(body.scStateOutMsg)
+    module = _flight_module(bsk, sim, task, drive, body, wheels=False, tag="staregen_tanh")
     ext.cmdTorqueInMsg.subscribeTo(module.cmdTorqueOutMsg)
-    sim.AddModelToTask(task, module, _PRIORITY["flight"])
     states = body.scStateOutMsg.recorder()
     sim.AddModelToTask(task, states, _PRIORITY["recorders"])
-    sim.InitializeSimulation()
-    sim.ConfigureStopTime(_nanos(n * h))
-    sim.ExecuteSimulation()
+    _execute(sim, n * h)
     return _tanh_history(sc, states, drive, n, h, bsk)
 
 
