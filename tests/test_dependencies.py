@@ -25,3 +25,14 @@ def test_torch_is_the_pinned_cpu_build_and_gpytorch_runs_on_it():
     with torch.no_grad():
         k = gpytorch.kernels.RBFKernel()(torch.zeros(1, 2), torch.zeros(1, 2)).to_dense()
     assert float(k[0, 0]) == 1.0          # exp(0): the squared-exponential kernel at zero distance
+
+
+def test_the_basilisk_extra_is_pinned_and_installed_by_make_test():
+    """Issue 28: `make test` installs the optional extra `basilisk` (bsk pinned); `make run` does not need it."""
+    extra = PYPROJECT["project"]["optional-dependencies"]["basilisk"]
+    assert extra == ["bsk==2.12.1"]
+    assert metadata.version("bsk") == "2.12.1"
+    root = Path(__file__).resolve().parents[1]
+    makefile = (root / "Makefile").read_text()
+    assert "test: setup-test\n" in makefile and "\t@bash tools/setup.sh test\n" in makefile
+    assert 'extras="dev,basilisk"' in (root / "tools" / "setup.sh").read_text()
