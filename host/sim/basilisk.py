@@ -39,7 +39,7 @@ import numpy as np
 
 from host.control.controllers import Controller, Measurement
 from host.core.constants import MU_EARTH
-from host.core.rotations import euler312_from_dcm, quat_from_dcm
+from host.core.rotations import quat_from_dcm
 from host.core.timebase import add_seconds
 from host.core.vec3 import dcm_from_quat3
 from host.errors import HostError
@@ -47,10 +47,9 @@ from host.plant import orbit
 from host.plant.earth import L_ei, earth_rate_vector
 from host.plant.environment import EARTH_RADIUS_DIPOLE, IGRF2015_DIPOLE_NT, WGS84_A, EnvironmentTrack, L_oi, \
     atmosphere_band
-from host.plant.sensors import measure
 from host.plant.spacecraft import saturate_torque
 from host.sim import tanh_example as tanh_ex
-from host.sim.simulator import SCENARIO_EPOCH, History, SimConfig, environment_track, initial_state, run_noise, \
+from host.sim.simulator import SCENARIO_EPOCH, History, SimConfig, environment_track, initial_state, run_noise, sense, \
     true_errors
 
 BSK_VERSION = "2.12.1"
@@ -62,7 +61,7 @@ _MODULES = {"messaging": "Basilisk.architecture.messaging", "sysModel": "Basilis
             "spacecraft": "Basilisk.simulation.spacecraft",
             "rw": "Basilisk.simulation.reactionWheelStateEffector",
             "gg": "Basilisk.simulation.GravityGradientEffector", "ext": "Basilisk.simulation.extForceTorque",
-            "base": "Basilisk.utilities.SimulationBaseClass", "macros": "Basilisk.utilities.macros",
+            "base": "Basilisk.utilities.SimulationBaseClass",
             "grav": "Basilisk.utilities.simIncludeGravBody", "rwf": "Basilisk.utilities.simIncludeRW",
             "atmosphere": "Basilisk.simulation.exponentialAtmosphere", "wind": "Basilisk.simulation.zeroWindModel",
             "drag": "Basilisk.simulation.dragDynamicEffector",
@@ -173,15 +172,11 @@ class _StaringDrive:
 
     def measurement(self, j: int, st, bsk) -> Measurement:
         t = j * self.cfg.plant_step
-        jd, sec = add_seconds(*SCENARIO_EPOCH, t)
         R, V = np.array(st.r_BN_N, float), np.array(st.v_BN_N, float)
         L_bi = np.array(bsk.rbk.MRP2C(np.array(st.sigma_BN, float)), float)
         k = j // self.sub
-        A_bo = measure(euler312_from_dcm(L_bi @ L_oi(R, V).T), self.cfg.errors.star, self.noise.star[k],
-                       self.cfg.sensor_errors)
-        w = measure(np.array(st.omega_BN_B, float), self.cfg.errors.gyro, self.noise.gyro[k], self.cfg.sensor_errors)
-        return Measurement(t=t, jd_days=int(jd), sec_of_day=float(sec), A_bo=A_bo, omega_b=w, R_s=R, V_s=V,
-                           lon=self.lon, lat=self.lat)
+        return sense(L_bi, L_oi(R, V), np.array(st.omega_BN_B, float), R, V, *add_seconds(*SCENARIO_EPOCH, t), t,
+                     self.noise.star[k], self.noise.gyro[k], self.lon, self.lat, self.cfg)
 
     def __call__(self, j: int, st) -> np.ndarray:
         bsk = basilisk()
@@ -201,35 +196,34 @@ def disturbance_names(cfg: SimConfig) -> list[str]:
     p = cfg.disturbances
     if not cfg.external_torques:
         return []
-    names = [name for name, on in (("gravity gradient", p.gravity_gradient), ("drag", p.drag_area > 0),
-                                   ("magnetic", bool(np.any(p.residual_dipole != 0))),
-                                   ("solar radiation", p.srp_area > 0)) if on]
-    return names
+    return [name for name, on in (("gravity gradient", p.gravity_gradient), ("drag", p.drag_area > 0),
+                                  ("magnetic", bool(np.any(p.residual_dipole != 0))),
+                                  ("solar radiation", p.srp_area > 0)) if on]
 
 
 def _add_disturbances(bsk, sim, task: str, sc, earth, cfg: SimConfig) -> list:
     """Basilisk's effectors for the disturbances of cfg.disturbances; returns the Python-side objects that
     must outlive the set-up (Basilisk keeps references to their messages only)."""
-    p, kept = cfg.disturbances, []
-    if p.srp_area > 0:
+    p, kept, names = cfg.disturbances, [], disturbance_names(cfg)
+    if "solar radiation" in names:
         raise HostError("Basilisk here has no solar-radiation torque (it needs SPICE ephemerides); switch it off "
                         "(srp_area = 0) on both sides")
-    if p.gravity_gradient:
+    if "gravity gradient" in names:
         gg = bsk.gg.GravityGradientEffector()
         gg.ModelTag = sc.ModelTag
         gg.addPlanetName(earth.planetName)
         sc.addDynamicEffector(gg)
         sim.AddModelToTask(task, gg, _PRIORITY["effectors"])
         kept.append(gg)
-    if p.drag_area <= 0 and not np.any(p.residual_dipole != 0):
+    if "drag" not in names and "magnetic" not in names:
         return kept
     planet = _module_class(bsk).earth(cfg.plant_step)
     planet.ModelTag = "staregen_earth"
     sim.AddModelToTask(task, planet, _PRIORITY["earth"])
     kept.append(planet)
-    if p.drag_area > 0:
+    if "drag" in names:
         kept += _add_drag(bsk, sim, task, sc, planet, p)
-    if np.any(p.residual_dipole != 0):
+    if "magnetic" in names:
         kept += _add_residual_dipole(bsk, sim, task, sc, planet, p)
     return kept
 
@@ -343,7 +337,7 @@ def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig =
     earth.isCentralBody = True
     earth.mu = MU_EARTH
     grav.addBodiesTo(sc)
-    kept = _add_disturbances(bsk, sim, task, sc, earth, cfg) if cfg.external_torques else []
+    kept = _add_disturbances(bsk, sim, task, sc, earth, cfg)
 
     factory, rw = _add_wheels(bsk, sim, task, sc, cfg, omega0)
     drive = _StaringDrive(controller, lon, lat, cfg, stream, n)

@@ -149,16 +149,23 @@ class _Recorder:
         self.mode = np.empty(n, dtype=object)
 
 
-def _measure(x, env, k_sample, t, noise_star, noise_gyro, gps, lon, lat, cfg: SimConfig) -> Measurement:
-    q, w, _ = unpack_state(x)
-    L_bo = dcm_from_quat3(q) @ env.L_oi[k_sample].T
-    A_bo = measure(euler312_from_dcm(L_bo), cfg.errors.star, noise_star, cfg.sensor_errors)
+def sense(L_bi, L_oi, omega_b, R, V, jd_days, sec_of_day, t, noise_star, noise_gyro, lon, lat,
+          cfg: SimConfig) -> Measurement:
+    """What the sensors give the controller of a true state (any simulator's): star sensor and gyro with
+    the scenario's errors and this instant's noise, the §7.6.1 extra angle, the ideal GPS."""
+    A_bo = measure(euler312_from_dcm(L_bi @ L_oi.T), cfg.errors.star, noise_star, cfg.sensor_errors)
     if cfg.attitude_offset is not None:
         A_bo = euler312_from_dcm(dcm_from_euler312(np.asarray(cfg.attitude_offset(t), float)) @ dcm_from_euler312(A_bo))
-    R, V = gps.measure(env.R[k_sample], env.V[k_sample])
-    return Measurement(t=t, jd_days=int(env.jd_days[k_sample]), sec_of_day=float(env.sec_of_day[k_sample]),
-                       A_bo=A_bo, omega_b=measure(w, cfg.errors.gyro, noise_gyro, cfg.sensor_errors),
-                       R_s=R, V_s=V, lon=lon, lat=lat)
+    R, V = Gps().measure(R, V)
+    return Measurement(t=t, jd_days=int(jd_days), sec_of_day=float(sec_of_day), A_bo=A_bo,
+                       omega_b=measure(omega_b, cfg.errors.gyro, noise_gyro, cfg.sensor_errors), R_s=R, V_s=V,
+                       lon=lon, lat=lat)
+
+
+def _measure(x, env, k_sample, t, noise_star, noise_gyro, lon, lat, cfg: SimConfig) -> Measurement:
+    q, w, _ = unpack_state(x)
+    return sense(dcm_from_quat3(q), env.L_oi[k_sample], w, env.R[k_sample], env.V[k_sample], env.jd_days[k_sample],
+                 env.sec_of_day[k_sample], t, noise_star, noise_gyro, lon, lat, cfg)
 
 
 def _advance_one_period(x, cmd, j0: int, sub: int, env: EnvironmentTrack, rec: _Recorder,
@@ -189,14 +196,13 @@ def simulate(controller: Controller, lon: float, lat: float, config: SimConfig =
     n = n_ctrl * sub
     env = environment_track(n + 1, cfg.plant_step)
     noise = run_noise(cfg, cfg.seed, stream)
-    gps = Gps()
 
     controller.reset()
     x = initial_state(env, lon, lat)
     rec = _Recorder(n)
     for k in range(n_ctrl):
         j0 = k * sub
-        out = controller.step(_measure(x, env, j0, env.t[j0], noise.star[k], noise.gyro[k], gps, lon, lat, cfg))
+        out = controller.step(_measure(x, env, j0, env.t[j0], noise.star[k], noise.gyro[k], lon, lat, cfg))
         cmd = np.asarray(out.torque, float)
         rec.cmd[j0:j0 + sub] = cmd
         rec.mode[j0:j0 + sub] = out.mode
