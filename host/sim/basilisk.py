@@ -307,7 +307,10 @@ def _add_wheels(bsk, sim, task: str, sc, cfg: SimConfig, omega0: np.ndarray):
 def staring_run(controller: Controller, lon: float, lat: float, cfg: SimConfig = SimConfig(), stream: int = 0) -> History:
     """Fly `controller` (stepped at the control period) staring at (lon, lat) in Basilisk; the
     signature of host.sim.simulator.simulate (cfg.external_torques and cfg.disturbances choose the
-    disturbances, as in staregen's simulator)."""
+    disturbances, as in staregen's simulator). cfg.attitude_offset acts through the shared sensor read;
+    cfg.extra_torque, a test input of staregen's simulator, is refused rather than silently dropped."""
+    if cfg.extra_torque is not None:
+        raise HostError("SimConfig.extra_torque (a test input of staregen's simulator) is not flown in Basilisk")
     bsk = basilisk()
     sub, n_ctrl = cfg.substeps, cfg.control_steps
     n = n_ctrl * sub

@@ -100,6 +100,13 @@ def test_each_disturbance_moves_both_bodies_alike(name, only):
     assert np.max(np.abs(a.omega_b - b.omega_b)) < 1e-3 * effect
 
 
+def test_a_test_input_basilisk_does_not_fly_is_refused():
+    tg = central_target()
+    cfg = SimConfig(duration=1.0, extra_torque=lambda t: np.ones(3))
+    with pytest.raises(HostError, match="extra_torque .* is not flown in Basilisk"):
+        basilisk.staring_run(ConstantTorque([0.0, 0.0, 0.0]), tg.lon, tg.lat, cfg)
+
+
 def test_solar_radiation_is_refused_in_one_line():
     tg = central_target()
     with pytest.raises(HostError, match="Basilisk here has no solar-radiation torque"):
