@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from codegen import artifact as art
+from codegen.errors import CodegenError
+from host.errors import HostError
 from host.cli.args import parse_int
 from host.control.standin import fit_pid_standin
 
@@ -35,16 +38,32 @@ def run_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def writable_artifact_path(out: str) -> Path:
+    """--out of a command that writes an artifact: a new file, or an artifact file (ours) it replaces; a
+    folder or any other existing file is refused in one line, before any work."""
+    path = Path(out)
+    if path.is_dir():
+        raise HostError(f"--out {out}: is a folder (give a file name)")
+    if path.exists():
+        try:
+            art.load(path)
+        except CodegenError:
+            raise HostError(f"--out {out}: exists and is not a staregen artifact; not overwritten") from None
+    return path
+
+
 def run_random(args: argparse.Namespace) -> int:
     seed = parse_int(args.seed, "--seed", maximum=2**32 - 1)
+    out = writable_artifact_path(args.out)
     a = art.random_artifact(art.parse_shape(args.shape), seed)   # refused before allocating
-    path = a.save(args.out)
+    path = a.save(out)
     print(f"wrote {path}: {a.shape_text}, seed {seed}, sha256 {a.sha256}")
     return 0
 
 
 def run_standin(args: argparse.Namespace) -> int:
+    out = writable_artifact_path(args.out)
     a = fit_pid_standin()
-    path = a.save(args.out)
+    path = a.save(out)
     print(f"wrote {path}: {a.shape_text} stand-in fitted to the Table 1 PID law, sha256 {a.sha256}")
     return 0

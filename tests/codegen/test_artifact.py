@@ -294,15 +294,22 @@ def test_cli_random_then_check(monkeypatch, capsys, tmp_path):
     (["artifact", "check", "{bad}"], "payload.envelope.min[0]: envelope min"),
     (["artifact", "check", "{missing}"], "no such file"),
     (["artifact", "random", "--shape", "12-x-3", "--out", "{out}"], "--shape"),
+    (["artifact", "random", "--out", "{mine}"], "exists and is not a staregen artifact; not overwritten"),
+    (["artifact", "standin", "--out", "{mine}"], "exists and is not a staregen artifact; not overwritten"),
+    (["artifact", "standin", "--out", "{folder}"], "is a folder (give a file name)"),
 ])
 def test_cli_bad_input_gives_one_line_and_non_zero_exit(monkeypatch, capsys, tmp_path, document, argv, needle):
     bad = tmp_path / "bad.json"
     document["payload"]["envelope"]["min"][0] = document["payload"]["envelope"]["max"][0]
     bad.write_text(json.dumps(reseal(document)))
-    paths = {"bad": str(bad), "missing": str(tmp_path / "nope.json"), "out": str(tmp_path / "o.json")}
+    mine = tmp_path / "mine.txt"
+    mine.write_text("a user's file\n")
+    paths = {"bad": str(bad), "missing": str(tmp_path / "nope.json"), "out": str(tmp_path / "o.json"),
+             "mine": str(mine), "folder": str(tmp_path)}
     code, out, err = run_cli(monkeypatch, capsys, *[a.format(**paths) for a in argv])
     assert code != 0
     assert len(err.strip().splitlines()) == 1 and needle in err and "Traceback" not in err
+    assert mine.read_text() == "a user's file\n"
 
 
 def test_cli_standin_writes_the_stand_in_network(monkeypatch, capsys, tmp_path):
