@@ -43,7 +43,7 @@ def writable_artifact_path(out: str) -> Path:
     folder or any other existing file is refused in one line, before any work."""
     path = Path(out)
     if path.is_dir():
-        raise HostError(f"--out {out}: is a folder (give a file name)")
+        raise HostError(f"--out {out}: is a directory (give a file name)")
     if path.exists():
         try:
             art.load(path)

@@ -296,7 +296,7 @@ def test_cli_random_then_check(monkeypatch, capsys, tmp_path):
     (["artifact", "random", "--shape", "12-x-3", "--out", "{out}"], "--shape"),
     (["artifact", "random", "--out", "{mine}"], "exists and is not a staregen artifact; not overwritten"),
     (["artifact", "standin", "--out", "{mine}"], "exists and is not a staregen artifact; not overwritten"),
-    (["artifact", "standin", "--out", "{folder}"], "is a folder (give a file name)"),
+    (["artifact", "standin", "--out", "{folder}"], "is a directory (give a file name)"),
 ])
 def test_cli_bad_input_gives_one_line_and_non_zero_exit(monkeypatch, capsys, tmp_path, document, argv, needle):
     bad = tmp_path / "bad.json"
